@@ -1,0 +1,209 @@
+"""The lumped-parameter catheter with modified Dahl tendon friction (the seed paper's model).
+
+One model serves the predictor, the controller's inverse, the virtual testbed's plant and
+the gap diagnosis. The physics is in `model.quasi_static_kernel`; this class holds the
+parameters, the state, input validation and the public API.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from model.effect_terms import EffectTerms
+from model.params import CatheterParams
+from model.quasi_static_kernel import (N_PARAMS, N_SCALARS, P_ALPHA, P_EA, P_EAT, P_EI, P_FSC, P_MU, P_R,
+                                       P_RHO, P_SIGMA, S_ITERATIONS, S_UNCONVERGED, run_path)
+
+MIN_ELEMENTS = 4
+
+
+class ModelInputError(ValueError):
+    """A command given to the model is not finite or outside its configured range."""
+
+
+@dataclass
+class CatheterState:
+    """Everything that evolves: applied inputs, friction state, tensions and shape."""
+
+    applied_tendon_mm: np.ndarray   # (4,) tendon input after the drive-train play
+    applied_insertion_mm: np.ndarray  # (1,) free length after the tube play
+    friction_n: np.ndarray          # (4, N) Dahl force of each tendon/element crossing
+    sliding_mm: np.ndarray          # (4, N) tendon sliding past each element, toward the base
+    last_step_mm: np.ndarray        # (4, N) sliding increment of the last step (predicts the next)
+    tension_n: np.ndarray           # (4, N) mean tendon tension over each element
+    bend_rad: np.ndarray            # (N, 2) element bend vectors
+    compression_mm: np.ndarray      # (N,) element axial compression
+    tip_tension_n: np.ndarray       # (4,) tension at the tip anchor
+    drive_tension_n: np.ndarray     # (4,) tension where the tendon leaves the catheter base
+    slack: np.ndarray               # (4,) bool
+    points_mm: np.ndarray           # (N+1, 3) backbone
+    frames: np.ndarray              # (N+1, 3, 3) element base orientations
+    diagnostics: np.ndarray         # (N_SCALARS,) solver counters
+
+    @classmethod
+    def straight(cls, n_elements: int, free_length_mm: float) -> "CatheterState":
+        n = n_elements
+        points = np.zeros((n + 1, 3))
+        points[:, 2] = np.linspace(0.0, free_length_mm, n + 1)
+        return cls(np.zeros(4), np.array([float(free_length_mm)]), np.zeros((4, n)), np.zeros((4, n)),
+                   np.zeros((4, n)), np.zeros((4, n)), np.zeros((n, 2)), np.zeros(n), np.zeros(4),
+                   np.zeros(4), np.zeros(4, dtype=np.bool_), points, np.tile(np.eye(3), (n + 1, 1, 1)),
+                   np.zeros(N_SCALARS))
+
+    def copy(self) -> "CatheterState":
+        return CatheterState(**{f.name: getattr(self, f.name).copy() for f in dataclasses.fields(self)})
+
+
+class DahlCatheter:
+    """N lumped elements with a Dahl friction element at every tendon/element crossing.
+
+    Inputs: tendon displacements [mm] (positive = pulled) for tendons at 0, 90, 180, 270 deg,
+    and the insertion, i.e. the free length [mm] out of the support tube. Outputs are in the
+    base frame: origin at the tube exit, z out of the tube, x toward tendon 1.
+    The tip is reported as the tip sensor sees it (plus `effects.tracker_offset_mm`, 0 by default).
+
+    Motion is quasi-static: each input change is followed in sub-steps of at most
+    `max_tendon_step_mm` of tendon and `max_insertion_step_mm` of insertion, so the friction
+    history follows the path.
+    """
+
+    def __init__(self, params: CatheterParams, n_elements: int = 20, effects: EffectTerms = EffectTerms(),
+                 max_tendon_step_mm: float = 0.05, max_insertion_step_mm: float = 0.5):
+        if isinstance(n_elements, bool) or not isinstance(n_elements, (int, np.integer)) \
+                or n_elements < MIN_ELEMENTS:
+            raise ValueError(f"n_elements must be an integer >= {MIN_ELEMENTS}, got {n_elements!r}")
+        if not (max_tendon_step_mm > 0 and max_insertion_step_mm > 0):
+            raise ValueError("max_tendon_step_mm and max_insertion_step_mm must be > 0")
+        self.params = params
+        self.n_elements = int(n_elements)
+        self.effects = effects
+        self.max_tendon_step_mm = float(max_tendon_step_mm)
+        self.max_insertion_step_mm = float(max_insertion_step_mm)
+        self._kernel_params = self._pack(params)
+        self._kernel_effects = effects.kernel_vector()
+        self._tracker_offset_mm = np.asarray(effects.tracker_offset_mm, dtype=float)
+        self.reset()
+
+    @staticmethod
+    def _pack(p: CatheterParams) -> np.ndarray:
+        v = np.empty(N_PARAMS)
+        v[P_R] = p.tendon_offset_mm
+        v[P_EI] = p.bending_stiffness_nmm2
+        v[P_EA] = p.axial_stiffness_n
+        v[P_EAT] = p.tendon_stiffness_n
+        v[P_MU] = p.mu
+        v[P_FSC] = p.fsc_n_per_mm
+        v[P_SIGMA] = p.sigma_n_per_mm2
+        v[P_ALPHA] = p.alpha
+        v[P_RHO] = p.linear_density_kg_per_mm
+        return v
+
+    # -- state -------------------------------------------------------------------------
+    def reset(self) -> None:
+        """Straight, unloaded, at the parameters' free length, with zero friction state."""
+        self.state = CatheterState.straight(self.n_elements, self.params.free_length_mm)
+
+    def snapshot(self) -> CatheterState:
+        """A copy of the state, to restore later with `restore` (e.g. for prediction)."""
+        return self.state.copy()
+
+    def restore(self, state: CatheterState) -> None:
+        self.state = state.copy()
+
+    # -- motion ------------------------------------------------------------------------
+    def move_to(self, tendons_mm, insertion_mm: float | None = None) -> np.ndarray:
+        """Drive quasi-statically from the current state to this input; returns the tip [mm].
+
+        History carries over: the friction state evolves along the straight-line input path.
+        """
+        if insertion_mm is None:
+            insertion_mm = float(self.state.applied_insertion_mm[0])
+        tendons, insertion = self._validated(np.asarray(tendons_mm, dtype=float).reshape(1, -1),
+                                             np.asarray([insertion_mm], dtype=float).reshape(-1))
+        return self._run(tendons, insertion, np.inf)[0]
+
+    def run(self, tendons_mm, insertion_mm=None, dt_s: float = 0.01) -> np.ndarray:
+        """Drive along a sampled input path tendons_mm[T, 4], insertion_mm[T]; tips [T, 3] in mm.
+
+        dt_s is the sample period; it matters only for rate-dependent effects.
+        """
+        tendons = np.asarray(tendons_mm, dtype=float)
+        if insertion_mm is None:
+            insertion_mm = np.full(len(tendons), float(self.state.applied_insertion_mm[0]))
+        tendons, insertion = self._validated(tendons, np.asarray(insertion_mm, dtype=float))
+        if not (dt_s > 0):
+            raise ModelInputError(f"dt_s must be > 0, got {dt_s!r}")
+        return self._run(tendons, insertion, float(dt_s))
+
+    def _run(self, tendons: np.ndarray, insertion: np.ndarray, dt_s: float) -> np.ndarray:
+        s = self.state
+        tips = np.empty((len(tendons), 3))
+        run_path(tendons, insertion, dt_s, self.max_tendon_step_mm, self.max_insertion_step_mm,
+                 self._kernel_params, self._kernel_effects, s.applied_tendon_mm, s.applied_insertion_mm,
+                 s.friction_n, s.sliding_mm, s.last_step_mm, s.tension_n, s.bend_rad, s.compression_mm,
+                 s.tip_tension_n, s.drive_tension_n, s.slack, s.points_mm, s.frames, s.diagnostics, tips)
+        return tips + self._tracker_offset_mm
+
+    def _validated(self, tendons: np.ndarray, insertion: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Check shapes, finiteness and ranges before anything touches the state."""
+        if tendons.ndim != 2 or tendons.shape[1] != 4:
+            raise ModelInputError(f"tendon commands must have shape (T, 4), got {tendons.shape}")
+        if insertion.shape != (tendons.shape[0],):
+            raise ModelInputError(f"insertion must have shape ({tendons.shape[0]},), got {insertion.shape}")
+        bad = ~np.isfinite(tendons)
+        if bad.any():
+            t, k = np.argwhere(bad)[0]
+            raise ModelInputError(f"tendon {k + 1} command at sample {t} is {tendons[t, k]}: must be finite")
+        if not np.isfinite(insertion).all():
+            t = int(np.argwhere(~np.isfinite(insertion))[0, 0])
+            raise ModelInputError(f"insertion at sample {t} is {insertion[t]}: must be finite")
+        low, high = self.params.tendon_range_mm
+        outside = (tendons < low) | (tendons > high)
+        if outside.any():
+            t, k = np.argwhere(outside)[0]
+            raise ModelInputError(f"tendon {k + 1} command {tendons[t, k]:.3f} mm at sample {t} is outside "
+                                  f"the configured range [{low}, {high}] mm")
+        lo, hi = self.params.min_free_length_mm, self.params.max_free_length_mm
+        outside = (insertion < lo) | (insertion > hi)
+        if outside.any():
+            t = int(np.argwhere(outside)[0, 0])
+            raise ModelInputError(f"free length {insertion[t]:.3f} mm at sample {t} is outside "
+                                  f"[{lo}, {hi}] mm (it cannot be negative or beyond the catheter)")
+        return np.ascontiguousarray(tendons), np.ascontiguousarray(insertion)
+
+    # -- outputs -----------------------------------------------------------------------
+    @property
+    def tip_mm(self) -> np.ndarray:
+        return self.state.points_mm[-1] + self._tracker_offset_mm
+
+    @property
+    def backbone_mm(self) -> np.ndarray:
+        """(N+1, 3) element end points from the tube exit to the tip."""
+        return self.state.points_mm.copy()
+
+    @property
+    def tendon_tension_n(self) -> np.ndarray:
+        """(4, N) mean tension of each tendon over each element."""
+        return self.state.tension_n.copy()
+
+    @property
+    def drive_tension_n(self) -> np.ndarray:
+        """(4,) tension of each tendon at the catheter base (what the drive pulls against)."""
+        return self.state.drive_tension_n.copy()
+
+    @property
+    def curvature_per_mm(self) -> np.ndarray:
+        """(N,) curvature of each element: |b_i| / h."""
+        h = self.free_length_mm / self.n_elements
+        return np.hypot(self.state.bend_rad[:, 0], self.state.bend_rad[:, 1]) / h
+
+    @property
+    def free_length_mm(self) -> float:
+        return float(self.state.applied_insertion_mm[0])
+
+    @property
+    def solver_iterations(self) -> tuple[int, int]:
+        """(secant iterations in total, steps that hit the iteration limit) since reset."""
+        return int(self.state.diagnostics[S_ITERATIONS]), int(self.state.diagnostics[S_UNCONVERGED])

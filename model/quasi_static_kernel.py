@@ -1,0 +1,524 @@
+"""The one kernel of the lumped Dahl catheter: a quasi-static step, compiled with numba.
+
+Generalised coordinates (seed paper II.A). Element i (i = 0 at the base, N-1 at the tip) of
+length h = L/N has a bend b_i = (bx, by) [rad] and an axial compression c_i [mm]. Bending
+and axial springs sit on each element, so in these coordinates the stiffness is diagonal:
+K_b = EI/h [N*mm/rad], K_a = EA/h [N/mm]. The kernel is linear; cost grows linearly in N.
+
+Quasi-static motion (paper I.A). Inertia and damping forces vanish at quasi-static rates,
+so each step solves static equilibrium; the path still matters through the friction state.
+The element masses (density*h) enter as gravity loads through the contact Jacobian.
+
+Tendons (paper II.A-B). Tendon k sits at radius r and angle phi_k = (k-1)*90 deg (plus the
+twist term), is fixed at the tip and pulled by u_k [mm] at the base. Its tension just
+distal of element i is T_k^tip + sum_{j>i} F_kj, where F_kj is the Dahl friction force of
+the element it crosses (paper II.B: each more proximal tension adds the friction of the
+elements distal to it). With the mean tension over the element T_ki = T_k^tip +
+sum_{j>i} F_kj + F_ki/2, equilibrium of element i is
+
+    b_i = b_rest,i + b_ext,i + (r/K_b) * sum_k T_ki e_k,       e_k = (cos phi_k, sin phi_k)
+    c_i = (h/EA) * sum_k T_ki
+
+and the lumen of tendon k shortens by delta_ki = c_i + r (b_i - b_rest,i).e_k; the tendon
+itself stretches by (h/EA_t) T_ki. Compatibility of an inextensible, taut tendon is
+
+    sum_i [delta_ki + (h/EA_t) T_ki] + c_drive * T_k^drive = u_k         (T_k^tip >= 0)
+
+and a tendon that would need to push is slack (zero tension). Sliding of tendon k past
+element i (toward the base) is x_ki = sum_{j>i} delta'_kj + delta'_ki/2, with delta' the
+shortening plus stretch, and the Dahl force follows paper eq. 1 with Fs from eq. 3.
+
+Implicit solution. Everything at element i is affine in the four tip tensions, because the
+friction increment is linearised, F_ki = F_ki^0 + k_ki (x_ki - x_ki^0) + g_ki (T_ki - T_ki^0). One sweep from
+tip to base carries these affine maps (a 4x4 solve per element), compatibility then gives
+the tip tensions (a 4x4 complementarity problem for slack tendons). Newton iterations
+re-linearise each element about the last iterate, in sliding and in mean tension (the
+capstan dependence of Fs), with the derivatives of the exactly integrated Dahl law, until
+the exact and the linearised friction forces agree. This is unconditionally stable for stiff friction, unlike the
+explicit use of the previous step's friction.
+"""
+import math
+
+import numpy as np
+from numba import njit
+
+from model.backbone_geometry import compose_backbone
+from model.dahl_friction import capstan_gain, dahl_update_with_slopes
+from model.effect_terms import (E_BACKLASH, E_GX, E_GY, E_GZ, E_KAPPA0_X, E_KAPPA0_Y, E_LUMEN_COEF,
+                                E_LUMEN_EXTENT, E_RATE, E_TENDON_COMPLIANCE, E_TUBE_PLAY, E_TWIST)
+from model.linear_algebra import solve_in_place
+
+# Positions in the kernel's parameter vector (see DahlCatheter._kernel_params).
+P_R = 0        # tendon offset r, mm
+P_EI = 1       # bending stiffness EI, N*mm^2
+P_EA = 2       # axial stiffness EA, N
+P_EAT = 3      # tendon axial stiffness EA_t, N
+P_MU = 4       # capstan friction coefficient
+P_FSC = 5      # constant friction per mm of length, N/mm
+P_SIGMA = 6    # Dahl stiffness per mm of length, N/mm^2
+P_ALPHA = 7    # Dahl exponent
+P_RHO = 8      # linear density, kg/mm
+N_PARAMS = 9
+
+# Positions in the state's diagnostics vector.
+S_ITERATIONS = 0    # Newton iterations used in total
+S_UNCONVERGED = 1   # steps that hit the iteration limit
+N_SCALARS = 2
+
+MAX_NEWTON_ITERATIONS = 12
+FORCE_TOLERANCE_N = 1e-4  # exact vs linearised Dahl force per element; 1e-4 N moves the tip < 1 um
+
+
+@njit(cache=True)
+def play_operator(previous: float, target: float, width: float) -> float:
+    """Backlash (play) of total width w: the output follows once the input leaves the band.
+
+        y = min(max(y_prev, x - w/2), x + w/2)
+    """
+    half = 0.5 * width
+    return min(max(previous, target - half), target + half)
+
+
+@njit(cache=True)
+def _element_modifiers(n, length, params, effects, tension, bend_prev, points, frames,
+                       arm, angle, rest_bend, ext_bend):
+    """Per-element terms from the effect vector and the previous step's state.
+
+    arm_i = r / (1 + c_lumen * sum_k T_ki * exp(-s_i / extent))      (lumen compression)
+    angle offset_i = twist * (i + 1/2) / N                           (torsion)
+    b_rest,i = kappa0 * h                                            (precurvature)
+    b_ext,i from the gravity moment M_i = sum_{j>=i} (c_j - p_i) x (m_j g) in the
+    frame of element i: b_ext = (M_y, -M_x) / K_b (generalised force = J^T F).
+    """
+    h = length / n
+    kb = params[P_EI] / h
+    for i in range(n):
+        arm[i] = params[P_R]
+        if effects[E_LUMEN_COEF] > 0.0:
+            load = 0.0
+            for k in range(4):
+                load += max(tension[k, i], 0.0)
+            s_mid = (i + 0.5) * h
+            arm[i] /= 1.0 + effects[E_LUMEN_COEF] * load * math.exp(-s_mid / effects[E_LUMEN_EXTENT])
+        angle[i] = effects[E_TWIST] * (i + 0.5) / n
+        rest_bend[i, 0] = effects[E_KAPPA0_X] * h
+        rest_bend[i, 1] = effects[E_KAPPA0_Y] * h
+        ext_bend[i, 0] = 0.0
+        ext_bend[i, 1] = 0.0
+    g0 = effects[E_GX]
+    g1 = effects[E_GY]
+    g2 = effects[E_GZ]
+    if g0 == 0.0 and g1 == 0.0 and g2 == 0.0:
+        return
+    weight = params[P_RHO] * h
+    f0 = weight * g0
+    f1 = weight * g1
+    f2 = weight * g2
+    sum_f = np.zeros(3)
+    sum_pxf = np.zeros(3)
+    for i in range(n - 1, -1, -1):
+        c0 = 0.5 * (points[i, 0] + points[i + 1, 0])
+        c1 = 0.5 * (points[i, 1] + points[i + 1, 1])
+        c2 = 0.5 * (points[i, 2] + points[i + 1, 2])
+        sum_f[0] += f0
+        sum_f[1] += f1
+        sum_f[2] += f2
+        sum_pxf[0] += c1 * f2 - c2 * f1
+        sum_pxf[1] += c2 * f0 - c0 * f2
+        sum_pxf[2] += c0 * f1 - c1 * f0
+        p0 = points[i, 0]
+        p1 = points[i, 1]
+        p2 = points[i, 2]
+        m0 = sum_pxf[0] - (p1 * sum_f[2] - p2 * sum_f[1])
+        m1 = sum_pxf[1] - (p2 * sum_f[0] - p0 * sum_f[2])
+        m2 = sum_pxf[2] - (p0 * sum_f[1] - p1 * sum_f[0])
+        local_x = frames[i, 0, 0] * m0 + frames[i, 1, 0] * m1 + frames[i, 2, 0] * m2
+        local_y = frames[i, 0, 1] * m0 + frames[i, 1, 1] * m1 + frames[i, 2, 1] * m2
+        ext_bend[i, 0] = local_y / kb
+        ext_bend[i, 1] = -local_x / kb
+
+
+@njit(cache=True)
+def _sweep(n, h, params, arm, cos_phi, sin_phi, ext_bend, f0, kx, gt, gth, bend_dir, xref, tref, slack,
+           lin_force, lin_tension, lin_shortening, lin_sliding, dist_force, dist_short):
+    """Tip-to-base sweep: affine maps (4 x 5: constant, then d/dT_tip) of every element quantity.
+
+    Friction is linearised about the last iterate (x_ref, T_ref, F0):
+        F = F0 + K (x - x_ref) + G (T - T_ref),   T = P + F/2,   x = S + (D T + d0)/2
+    with P = T_tip + C_dist and S = S_dist the distal sums, which gives per element
+        (I - K D/4 - G/2) F = F0 + K (S + D P/2 + d0/2 - x_ref) + G (P - T_ref).
+    K = diag(dF/dx). G_km = dF_k/dT_m holds the capstan dependence of Fs on the tendon's own
+    tension, gt_k (k = m), and on the element angle theta, which every tension bends:
+    gth_k * dtheta/dT_m with dtheta/dT_m = (r/K_b) (u . e_m), u the unit bend direction.
+    """
+    kb = params[P_EI] / h
+    ka = h / params[P_EA]
+    kt = h / params[P_EAT]
+    d = np.empty((4, 4))
+    a = np.empty((4, 4))
+    g = np.empty((4, 4))
+    rhs = np.empty((4, 5))
+    pull = np.empty((4, 5))
+    d0 = np.empty(4)
+    dist_force[:, :] = 0.0
+    dist_short[:, :] = 0.0
+    for i in range(n - 1, -1, -1):
+        r = arm[i]
+        e0 = cos_phi[i]
+        e1 = sin_phi[i]
+        for k in range(4):
+            d0[k] = r * (ext_bend[i, 0] * e0[k] + ext_bend[i, 1] * e1[k])
+            for m in range(4):
+                d[k, m] = ka + r * r / kb * (e0[k] * e0[m] + e1[k] * e1[m])
+            d[k, k] += kt
+            for col in range(5):
+                pull[k, col] = (1.0 if col == k + 1 else 0.0) + dist_force[k, col]
+        for k in range(4):
+            for m in range(4):
+                dtheta = r / kb * (bend_dir[i, 0] * e0[m] + bend_dir[i, 1] * e1[m])
+                g[k, m] = gth[k, i] * dtheta + (gt[k, i] if k == m else 0.0)
+        for k in range(4):
+            if slack[k]:
+                for m in range(4):
+                    a[k, m] = 1.0 if k == m else 0.0
+                for col in range(5):
+                    rhs[k, col] = 0.0
+                continue
+            kk = kx[k, i]
+            for m in range(4):
+                a[k, m] = (1.0 if k == m else 0.0) - 0.25 * kk * d[k, m] - 0.5 * g[k, m]
+            for col in range(5):
+                acc = 0.0
+                acc_g = 0.0
+                for m in range(4):
+                    acc += d[k, m] * pull[m, col]
+                    acc_g += g[k, m] * (pull[m, col] - (tref[m, i] if col == 0 else 0.0))
+                value = kk * (dist_short[k, col] + 0.5 * acc) + acc_g
+                if col == 0:
+                    value += f0[k, i] + kk * (0.5 * d0[k] - xref[k, i])
+                rhs[k, col] = value
+        solve_in_place(a, rhs, 4, 5)
+        for k in range(4):
+            for col in range(5):
+                lin_force[i, k, col] = rhs[k, col]
+                lin_tension[i, k, col] = pull[k, col] + 0.5 * rhs[k, col]
+        for k in range(4):
+            for col in range(5):
+                acc = d0[k] if col == 0 else 0.0
+                for m in range(4):
+                    acc += d[k, m] * lin_tension[i, m, col]
+                lin_shortening[i, k, col] = acc
+                lin_sliding[i, k, col] = dist_short[k, col] + 0.5 * acc
+        for k in range(4):
+            for col in range(5):
+                dist_force[k, col] += lin_force[i, k, col]
+                dist_short[k, col] += lin_shortening[i, k, col]
+
+
+@njit(cache=True)
+def _tip_tensions(u, compliance, dist_force, dist_short, slack, revived, tip_tension):
+    """Compatibility with slack tendons: a 4-variable complementarity problem, by active set.
+
+    G_k(T) = S_k(T) + c_drive*(T_k + C_k(T)) is the length the tendon path takes up.
+    Taut: G_k(T) = u_k with T_k >= 0. Slack: T_k = 0 with G_k(T) >= u_k.
+    A tendon re-tightened during this step (`revived`) stays taut for the step: pulled against
+    its own friction it may carry a small negative tip tension (at most its friction), since the
+    model does not resolve partial slack along one tendon.
+    Updates `slack` and `revived` in place; returns True if the set of slack tendons changed.
+    """
+    g = np.empty((4, 5))
+    for k in range(4):
+        for col in range(5):
+            basis = 1.0 if (col == k + 1) else 0.0
+            g[k, col] = dist_short[k, col] + compliance * (basis + dist_force[k, col])
+    assumed = slack.copy()
+    active = slack.copy()
+    mat = np.empty((4, 4))
+    vec = np.empty((4, 1))
+    idx = np.empty(4, dtype=np.int64)
+    for _ in range(10):
+        nt = 0
+        for k in range(4):
+            if not active[k]:
+                idx[nt] = k
+                nt += 1
+        for a in range(nt):
+            for b in range(nt):
+                mat[a, b] = g[idx[a], idx[b] + 1]
+            vec[a, 0] = u[idx[a]] - g[idx[a], 0]
+        for k in range(4):
+            tip_tension[k] = 0.0
+        if nt > 0:
+            solve_in_place(mat, vec, nt, 1)
+            for a in range(nt):
+                tip_tension[idx[a]] = vec[a, 0]
+        worst = -1
+        worst_value = -1e-12
+        for k in range(4):
+            if not active[k] and not revived[k] and tip_tension[k] < worst_value:
+                worst_value = tip_tension[k]
+                worst = k
+        if worst >= 0:
+            active[worst] = True
+            continue
+        retightened = False
+        for k in range(4):
+            if active[k]:
+                taken = g[k, 0]
+                for m in range(4):
+                    taken += g[k, m + 1] * tip_tension[m]
+                if taken < u[k] - 1e-12:
+                    active[k] = False
+                    retightened = True
+                    break
+        if not retightened:
+            break
+    changed = False
+    for k in range(4):
+        if active[k] != assumed[k]:
+            changed = True
+            if assumed[k]:
+                revived[k] = True
+        slack[k] = active[k]
+    return changed
+
+
+@njit(cache=True)
+def _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_per_step, friction, increment, tension,
+                       f0, kx, gt, gth, bend_dir):
+    """Exact Dahl forces of element i after the sliding `increment`, and their derivatives.
+
+    Fs = s*(Fsc + gain(theta)*T) with gain = 2 tanh(mu theta/2) (capstan_gain) and the
+    rate-friction scale s = 1 + c_rate*|v|, v = increment/dt (rate_per_step = c_rate/dt). Returns, per tendon, F0 = dahl_update(...), dF/dx, gt = dF/dFs * s*gain (own
+    tension), gth = dF/dFs * s*T*dgain/dtheta with dgain/dtheta = mu*(1 - tanh^2(mu theta/2)).
+    """
+    theta = math.sqrt(bx * bx + by * by)
+    gain = capstan_gain(mu, theta)
+    dgain = mu * (1.0 - 0.25 * gain * gain)
+    if theta > 1e-12:
+        bend_dir[i, 0] = bx / theta
+        bend_dir[i, 1] = by / theta
+    else:
+        bend_dir[i, 0] = 0.0
+        bend_dir[i, 1] = 0.0
+    for k in range(4):
+        s = 1.0 + rate_per_step * abs(increment[k, i])
+        t = max(tension[k, i], 0.0)
+        fs = s * (fsc + gain * t)
+        force, d_dx, d_fs = dahl_update_with_slopes(friction[k, i], increment[k, i], fs, sigma, alpha)
+        f0[k, i] = force
+        kx[k, i] = d_dx
+        gt[k, i] = d_fs * s * gain if tension[k, i] > 0.0 else 0.0
+        gth[k, i] = d_fs * s * t * dgain
+
+
+@njit(cache=True)
+def make_workspace(n):
+    """Scratch arrays for quasi_static_step, allocated once per run."""
+    return (np.empty(n), np.empty(n), np.empty((n, 2)), np.empty((n, 2)), np.empty((n, 4)), np.empty((n, 4)),
+            np.empty((4, n)), np.empty((4, n)), np.empty((4, n)), np.empty((4, n)), np.empty((n, 2)),
+            np.empty((4, n)), np.empty((4, n)), np.empty((n, 4, 5)), np.empty((n, 4, 5)), np.empty((n, 4, 5)),
+            np.empty((n, 4, 5)), np.empty((4, 5)), np.empty((4, 5)), np.empty((4, n)), np.empty((4, n)),
+            np.empty((4, n)), np.empty((n, 2)), np.empty(n), np.empty((4, n)), np.empty(4),
+            np.zeros(4, dtype=np.bool_), np.empty(n))
+
+
+@njit(cache=True)
+def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_step, tension,
+                      bend, compression, tip_tension, drive_tension, slack, points, frames, scalars, work):
+    """Advance the catheter state to equilibrium at tendon input u [mm] and free length [mm].
+
+    `dt_s` is the time the step takes (inf for a purely quasi-static move); it only enters
+    the rate-dependent friction term. All state arrays are updated in place; `work` is
+    scratch space from make_workspace.
+    """
+    n = bend.shape[0]
+    h = length / n
+    kb = params[P_EI] / h
+    sigma = params[P_SIGMA] * h
+    fsc = params[P_FSC] * h
+    mu = params[P_MU]
+    alpha = params[P_ALPHA]
+    compliance = effects[E_TENDON_COMPLIANCE]
+    rate_per_step = effects[E_RATE] / dt_s if (dt_s > 0.0 and math.isfinite(dt_s)) else 0.0
+
+    (arm, angle, rest_bend, ext_bend, cos_phi, sin_phi, f0, kx, gt, gth, bend_dir, xref, tref, lin_force,
+     lin_tension, lin_shortening, lin_sliding, dist_force, dist_short, new_force, new_sliding, new_tension,
+     new_bend, new_compression, increment, linear_force, revived, lengths) = work
+    _element_modifiers(n, length, params, effects, tension, bend, points, frames,
+                       arm, angle, rest_bend, ext_bend)
+    for i in range(n):  # tendon k at phi_k = k*90 deg + twist offset
+        c = math.cos(angle[i]) if angle[i] != 0.0 else 1.0
+        s = math.sin(angle[i]) if angle[i] != 0.0 else 0.0
+        cos_phi[i, 0], cos_phi[i, 1], cos_phi[i, 2], cos_phi[i, 3] = c, -s, -c, s
+        sin_phi[i, 0], sin_phi[i, 1], sin_phi[i, 2], sin_phi[i, 3] = s, c, -s, -c
+
+    # Linearisation of each friction element about (x_ref, T_ref, F0). First guess: this step
+    # slides as far as the last one did (constant velocity); then Newton updates from the
+    # exact Dahl integration at each iterate.
+    tref[:, :] = tension
+    for i in range(n):
+        _linearise_element(i, bend[i, 0], bend[i, 1], mu, fsc, sigma, alpha, rate_per_step, friction,
+                           last_step, tension, f0, kx, gt, gth, bend_dir)
+        for k in range(4):
+            xref[k, i] = sliding[k, i] + last_step[k, i]
+
+    increment[:, :] = 0.0
+    revived[:] = False
+    converged = False
+    for iteration in range(MAX_NEWTON_ITERATIONS):
+        scalars[S_ITERATIONS] += 1.0
+        _sweep(n, h, params, arm, cos_phi, sin_phi, ext_bend, f0, kx, gt, gth, bend_dir, xref, tref, slack,
+               lin_force, lin_tension, lin_shortening, lin_sliding, dist_force, dist_short)
+        if _tip_tensions(u, compliance, dist_force, dist_short, slack, revived, tip_tension):
+            continue
+        worst = 0.0
+        for i in range(n):
+            r = arm[i]
+            bx = rest_bend[i, 0] + ext_bend[i, 0]
+            by = rest_bend[i, 1] + ext_bend[i, 1]
+            total = 0.0
+            for k in range(4):
+                t = lin_tension[i, k, 0]
+                x = lin_sliding[i, k, 0]
+                for m in range(4):
+                    t += lin_tension[i, k, m + 1] * tip_tension[m]
+                    x += lin_sliding[i, k, m + 1] * tip_tension[m]
+                new_tension[k, i] = t
+                new_sliding[k, i] = x
+                bx += r / kb * t * cos_phi[i, k]
+                by += r / kb * t * sin_phi[i, k]
+                total += t
+            new_bend[i, 0] = bx
+            new_bend[i, 1] = by
+            new_compression[i] = h / params[P_EA] * total
+            for k in range(4):
+                if slack[k]:
+                    linear_force[k] = 0.0
+                    continue
+                linear = lin_force[i, k, 0]
+                for m in range(4):
+                    linear += lin_force[i, k, m + 1] * tip_tension[m]
+                increment[k, i] = new_sliding[k, i] - sliding[k, i]
+                linear_force[k] = linear
+            _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_per_step, friction, increment,
+                               new_tension, f0, kx, gt, gth, bend_dir)
+            for k in range(4):
+                if slack[k]:
+                    f0[k, i] = 0.0
+                    kx[k, i] = 0.0
+                    gt[k, i] = 0.0
+                    gth[k, i] = 0.0
+                new_force[k, i] = f0[k, i]
+                worst = max(worst, abs(f0[k, i] - linear_force[k]))
+                xref[k, i] = new_sliding[k, i]
+                tref[k, i] = new_tension[k, i]
+        if worst < FORCE_TOLERANCE_N:
+            converged = True
+            break
+    if not converged:
+        scalars[S_UNCONVERGED] += 1.0
+
+    for k in range(4):
+        drive = tip_tension[k]
+        for i in range(n):
+            last_step[k, i] = new_sliding[k, i] - sliding[k, i]
+            friction[k, i] = new_force[k, i]
+            sliding[k, i] = new_sliding[k, i]
+            tension[k, i] = new_tension[k, i]
+            drive += new_force[k, i]
+        drive_tension[k] = drive
+    for i in range(n):
+        bend[i, 0] = new_bend[i, 0]
+        bend[i, 1] = new_bend[i, 1]
+        compression[i] = new_compression[i]
+        lengths[i] = h - new_compression[i]
+    compose_backbone(bend, lengths, points, frames)
+
+
+@njit(cache=True)
+def remap_to_length(old_length, new_length, friction, sliding, last_step, tension):
+    """Carry the friction state along the material when the free length changes.
+
+    The tendons are driven from the insertion block, so they move with the catheter body:
+    material keeps its distance tau from the tip. Element i is centred at
+    tau_i = L - (i + 1/2) L/N. Friction force per unit length, sliding and tension are
+    interpolated in tau; material that leaves the support tube arrives straight with no
+    friction load, carrying the sliding of the base.
+    """
+    n = friction.shape[1]
+    if new_length == old_length:
+        return
+    h_old = old_length / n
+    h_new = new_length / n
+    old_force = friction.copy()
+    old_sliding = sliding.copy()
+    old_last_step = last_step.copy()
+    old_tension = tension.copy()
+    for i in range(n):
+        tau = new_length - (i + 0.5) * h_new
+        # fractional index in the old elements: tau = L_old - (j + 1/2) h_old
+        j = (old_length - tau) / h_old - 0.5
+        for k in range(4):
+            if j <= 0.0:
+                fade = max(0.0, 1.0 + j)  # fades to zero over the last half element into the tube
+                friction[k, i] = old_force[k, 0] / h_old * h_new * fade
+                sliding[k, i] = old_sliding[k, 0]
+                last_step[k, i] = old_last_step[k, 0]
+                tension[k, i] = old_tension[k, 0]
+            elif j >= n - 1:
+                friction[k, i] = old_force[k, n - 1] / h_old * h_new
+                sliding[k, i] = old_sliding[k, n - 1]
+                last_step[k, i] = old_last_step[k, n - 1]
+                tension[k, i] = old_tension[k, n - 1]
+            else:
+                j0 = int(j)
+                w = j - j0
+                friction[k, i] = ((1 - w) * old_force[k, j0] + w * old_force[k, j0 + 1]) / h_old * h_new
+                sliding[k, i] = (1 - w) * old_sliding[k, j0] + w * old_sliding[k, j0 + 1]
+                last_step[k, i] = (1 - w) * old_last_step[k, j0] + w * old_last_step[k, j0 + 1]
+                tension[k, i] = (1 - w) * old_tension[k, j0] + w * old_tension[k, j0 + 1]
+
+
+@njit(cache=True)
+def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_step_mm, params, effects,
+             applied_tendon_mm, applied_insertion_mm, friction, sliding, last_step, tension, bend,
+             compression, tip_tension, drive_tension, slack, points, frames, scalars, tips_out):
+    """Drive the model along a sampled input path; tips_out[t] is the tip after sample t.
+
+    Inputs pass the drive-train plays first (backlash per tendon, tube play on insertion).
+    Each sample is split into sub-steps of at most max_tendon_step_mm / max_insertion_step_mm
+    so that the friction state follows the path (history) and not just its end point.
+    """
+    n_samples = tendon_mm.shape[0]
+    target = np.empty(4)
+    u = np.empty(4)
+    work = make_workspace(bend.shape[0])
+    for t in range(n_samples):
+        for k in range(4):
+            target[k] = play_operator(applied_tendon_mm[k], tendon_mm[t, k], effects[E_BACKLASH])
+        length_target = play_operator(applied_insertion_mm[0], insertion_mm[t], effects[E_TUBE_PLAY])
+        span = 0.0
+        for k in range(4):
+            span = max(span, abs(target[k] - applied_tendon_mm[k]))
+        n_sub = max(1, int(math.ceil(span / max_tendon_step_mm)),
+                    int(math.ceil(abs(length_target - applied_insertion_mm[0]) / max_insertion_step_mm)))
+        start_length = applied_insertion_mm[0]
+        start = applied_tendon_mm.copy()
+        length = start_length
+        for j in range(1, n_sub + 1):
+            w = j / n_sub
+            for k in range(4):
+                u[k] = start[k] + w * (target[k] - start[k])
+            previous_length = length
+            length = start_length + w * (length_target - start_length)
+            remap_to_length(previous_length, length, friction, sliding, last_step, tension)
+            quasi_static_step(u, length, dt_s / n_sub, params, effects, friction, sliding, last_step,
+                              tension, bend, compression, tip_tension, drive_tension, slack, points,
+                              frames, scalars, work)
+        for k in range(4):
+            applied_tendon_mm[k] = target[k]
+        applied_insertion_mm[0] = length_target
+        nb = points.shape[0] - 1
+        for a in range(3):
+            tips_out[t, a] = points[nb, a]

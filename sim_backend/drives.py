@@ -1,0 +1,104 @@
+"""The set of simulated drives on one virtual CAN bus.
+
+All drives share one python-can ``virtual`` bus instance and one canopen.Network
+(its notifier thread runs their callbacks). A client (the crest driver, or
+canopen.RemoteNode / BaseNode402 in tests) opens its own
+``can.Bus(interface="virtual", channel=<same channel>)`` and talks to them as to
+hardware. A third bus instance on the channel feeds the bus-load meter, so it
+sees every frame, the drives' included.
+
+``tick(now_s)`` (s since the testbed started) drives the drives' time-based
+duties and fires scheduled per-axis faults; SYNC frames from the client drive
+their motion.
+"""
+
+from __future__ import annotations
+
+from typing import Iterable, Sequence
+
+import can
+import canopen
+
+from sim_backend.bus_load import BusLoadMeter, BusLoadReport
+from sim_backend.drive.drive_spec import DriveSpec
+from sim_backend.drive.sim_drive import SimDrive
+from sim_backend.faults import FaultSchedule, FaultSpec
+
+
+class SimDriveSet:
+    """Drives for ``specs`` on the virtual CAN channel ``channel``.
+
+    :param bitrate_bit_s, sync_period_s: the bus and SYNC timing the bus load is measured against.
+    :param faults: per-axis faults to inject at their time; tracker faults are ignored here.
+    """
+
+    def __init__(self, specs: Sequence[DriveSpec], channel: str, *, bitrate_bit_s: int = 1_000_000,
+                 sync_period_s: float = 0.01, faults: Iterable[FaultSpec] = ()) -> None:
+        _check_unique(specs)
+        self.channel = channel
+        self.drives: dict[str, SimDrive] = {spec.name: SimDrive(spec) for spec in specs}
+        drive_faults = [fault for fault in faults if not fault.targets_tracker]
+        for fault in drive_faults:
+            if fault.axis not in self.drives:
+                raise ValueError(f"fault {fault}: no drive named {fault.axis!r}; "
+                                 f"drives are {', '.join(self.drives)}")
+        self._schedule = FaultSchedule(drive_faults)
+        self.bus_load = BusLoadMeter(bitrate_bit_s, sync_period_s)
+        self._network: canopen.Network | None = None
+        self._meter_bus: can.BusABC | None = None
+        self._meter_notifier: can.Notifier | None = None
+
+    def drive(self, name: str) -> SimDrive:
+        try:
+            return self.drives[name]
+        except KeyError:
+            raise KeyError(f"no drive named {name!r}; drives are {', '.join(self.drives)}") from None
+
+    def start(self) -> None:
+        """Open the bus, attach the drives and power them on (each sends its boot-up message)."""
+        self._meter_bus = can.Bus(interface="virtual", channel=self.channel)
+        self._meter_notifier = can.Notifier(self._meter_bus, [self.bus_load])
+        self._network = canopen.Network(can.Bus(interface="virtual", channel=self.channel))
+        self._network.connect()
+        for drive in self.drives.values():
+            drive.attach(self._network)
+        for drive in self.drives.values():
+            drive.power_on()
+
+    def stop(self) -> None:
+        """Close the bus instances (the drives fall silent)."""
+        if self._network is not None:
+            self._network.disconnect()
+            self._network = None
+        if self._meter_notifier is not None:
+            self._meter_notifier.stop()
+            self._meter_notifier = None
+        if self._meter_bus is not None:
+            self._meter_bus.shutdown()
+            self._meter_bus = None
+
+    def __enter__(self) -> SimDriveSet:
+        self.start()
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        self.stop()
+
+    def tick(self, now_s: float) -> None:
+        """Time-based duties at ``now_s`` (s since start): scheduled faults, heartbeats, watchdogs."""
+        for fault in self._schedule.due(now_s):
+            self.drives[fault.axis].inject_fault(fault.kind)
+        for drive in self.drives.values():
+            drive.tick(now_s)
+
+    def bus_load_report(self) -> BusLoadReport:
+        return self.bus_load.report()
+
+
+def _check_unique(specs: Sequence[DriveSpec]) -> None:
+    names = [spec.name for spec in specs]
+    node_ids = [spec.node_id for spec in specs]
+    for label, values in (("name", names), ("node id", node_ids)):
+        duplicates = sorted({value for value in values if values.count(value) > 1}, key=str)
+        if duplicates:
+            raise ValueError(f"drives must have distinct {label}s; repeated: {duplicates}")
