@@ -307,7 +307,9 @@ def _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_per_step, friction
         fs = s * (fsc + gain * t)
         force, d_dx, d_fs = dahl_update_with_slopes(friction[k, i], increment[k, i], fs, sigma, alpha)
         f0[k, i] = force
-        kx[k, i] = d_dx
+        # dF/dx also moves Fs through the rate scale: ds/dx = c_rate/dt * sgn(dx)
+        rate_slope = rate_per_step * (fsc + gain * t) * (1.0 if increment[k, i] >= 0.0 else -1.0)
+        kx[k, i] = d_dx + d_fs * rate_slope
         gt[k, i] = d_fs * s * gain if tension[k, i] > 0.0 else 0.0
         gth[k, i] = d_fs * s * t * dgain
 

@@ -1,0 +1,89 @@
+"""The library of candidate unmodelled effects, under their canonical ids.
+
+Each maps its parameters onto `EffectTerms` fields that the one model kernel computes.
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from model.effect_terms import EffectTerms
+from model.effects.candidate_effect import CandidateEffect
+
+EFFECTS: dict[str, CandidateEffect] = {e.id: e for e in (
+    CandidateEffect(
+        id="tendon_elasticity",
+        physics="tendon and drive-line stretch under tension: the tip sees u - c*T_drive",
+        param_names=("compliance_mm_per_n",), typical=(0.05,), lower=(0.0,), upper=(0.5,),
+        signature="articulation lags the command in proportion to tension: error grows with total tension",
+        apply=lambda t, v: t.replace(tendon_compliance_mm_per_n=v[0])),
+    CandidateEffect(
+        id="backlash",
+        physics="a dead band of width w in each tendon drive train, crossed at every reversal",
+        param_names=("width_mm",), typical=(0.4,), lower=(0.0,), upper=(3.0,),
+        signature="a flat dead band just after each reversal, independent of speed and load",
+        apply=lambda t, v: t.replace(backlash_mm=v[0])),
+    CandidateEffect(
+        id="lumen_compression",
+        physics="lumens pushed toward the neutral axis under load near the base: the moment arm shrinks",
+        param_names=("coef_per_n", "extent_mm"), typical=(0.03, 20.0), lower=(0.0, 1.0), upper=(0.5, 200.0),
+        signature="less bending than predicted at high articulation, growing with tension, near the base",
+        apply=lambda t, v: t.replace(lumen_compression_per_n=v[0], lumen_compression_extent_mm=v[1])),
+    CandidateEffect(
+        id="tube_friction",
+        physics="catheter/support-tube friction: the free length lags the insertion axis by a play",
+        param_names=("play_mm",), typical=(2.0,), lower=(0.0,), upper=(10.0,),
+        signature="error along the catheter after insertion reversals, tied to free-length changes",
+        apply=lambda t, v: t.replace(tube_play_mm=v[0])),
+    CandidateEffect(
+        id="gravity",
+        physics="sag under the catheter's own weight: element masses loaded by g in the base frame",
+        param_names=("g_x_m_s2", "g_y_m_s2", "g_z_m_s2"), typical=(0.0, -9.81, 0.0),
+        lower=(-20.0, -20.0, -20.0), upper=(20.0, 20.0, 20.0),   # up to 2 g: a fluid-filled catheter weighs more
+        signature="a fixed-direction offset that grows with free length, present even at zero load",
+        apply=lambda t, v: t.replace(gravity_m_s2=(v[0], v[1], v[2]))),
+    CandidateEffect(
+        id="torsion",
+        physics="twist of the lumens along the catheter: each bending plane couples into the other",
+        param_names=("twist_rad",), typical=(0.25,), lower=(-1.0,), upper=(1.0,),
+        signature="error out of the commanded bending plane, proportional to articulation",
+        apply=lambda t, v: t.replace(twist_rad=v[0])),
+    CandidateEffect(
+        id="tracker_offset",
+        physics="a rigid registration error of the tip sensor: a constant offset of the measured tip",
+        param_names=("dx_mm", "dy_mm", "dz_mm"), typical=(1.0, -0.8, 0.6),
+        lower=(-10.0, -10.0, -10.0), upper=(10.0, 10.0, 10.0),
+        signature="a constant bias everywhere, including static holds at zero load",
+        apply=lambda t, v: t.replace(tracker_offset_mm=(v[0], v[1], v[2]))),
+    CandidateEffect(
+        id="rate_friction",
+        physics="velocity-strengthening tendon friction: Fs*(1 + c*|v|)",
+        param_names=("coef_s_per_mm",), typical=(0.1,), lower=(0.0,), upper=(5.0,),
+        signature="hysteresis loops that widen with speed; static holds agree",
+        apply=lambda t, v: t.replace(rate_friction_s_per_mm=v[0])),
+    CandidateEffect(
+        id="precurvature",
+        physics="residual rest curvature of the unactuated catheter",
+        param_names=("kappa_x_per_mm", "kappa_y_per_mm"), typical=(0.002, -0.001),
+        lower=(-0.02, -0.02), upper=(0.02, 0.02),
+        signature="a bend at zero load in a fixed plane, scaling with free length",
+        apply=lambda t, v: t.replace(precurvature_per_mm=(v[0], v[1]))),
+)}
+
+
+def effect(effect_id: str) -> CandidateEffect:
+    """The candidate effect with this canonical id; a clear error lists the known ones."""
+    try:
+        return EFFECTS[effect_id]
+    except KeyError:
+        raise ValueError(f"unknown effect {effect_id!r}; known effects: {', '.join(EFFECTS)}") from None
+
+
+def combined_terms(chosen: Mapping[str, Mapping[str, float] | tuple[float, ...]]) -> EffectTerms:
+    """EffectTerms with every effect in `chosen` switched on ({id: {param: value}} or {id: values})."""
+    terms = EffectTerms()
+    for effect_id, values in chosen.items():
+        candidate = effect(effect_id)
+        if isinstance(values, Mapping):
+            values = candidate.values_from(values)
+        terms = candidate.terms(tuple(values), terms)
+    return terms
