@@ -8,10 +8,10 @@ z out of the tube, x toward tendon 1.
 """
 import math
 
-from numba import njit
+from model.jit import kernel
 
 
-@njit(cache=True)
+@kernel
 def arc_transform(bx: float, by: float, length_mm: float, rot, offset) -> None:
     """Rotation and end point of one constant-curvature arc, in its base frame.
 
@@ -53,7 +53,7 @@ def arc_transform(bx: float, by: float, length_mm: float, rot, offset) -> None:
     offset[2] = length_mm * s_over_theta
 
 
-@njit(cache=True)
+@kernel
 def compose_backbone(bend_rad, length_mm, points_mm, frames) -> None:
     """Chain the element arcs from the base: p_{i+1} = p_i + R_i end_i, R_{i+1} = R_i R(b_i).
 

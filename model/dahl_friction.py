@@ -6,10 +6,10 @@ is the sliding of the tendon relative to the lumen, positive toward the base (te
 """
 import math
 
-from numba import njit
+from model.jit import kernel
 
 
-@njit(cache=True)
+@kernel
 def capstan_gain(mu: float, theta_rad: float) -> float:
     """dFs/dT_avg: the capstan part of the steady-state friction, Fs = Fsc + gain * T_avg.
 
@@ -24,7 +24,7 @@ def capstan_gain(mu: float, theta_rad: float) -> float:
     return 2.0 * math.tanh(0.5 * mu * abs(theta_rad))
 
 
-@njit(cache=True)
+@kernel
 def dahl_slope(force_n: float, fs_n: float, sigma_n_per_mm: float, alpha: float, direction: float) -> float:
     """dF/dx = sigma * (1 - F/Fs * sgn(v))^alpha  (paper eq. 1), clipped at 0 beyond Fs."""
     if fs_n <= 0.0:
@@ -35,7 +35,7 @@ def dahl_slope(force_n: float, fs_n: float, sigma_n_per_mm: float, alpha: float,
     return sigma_n_per_mm * (base if alpha == 1.0 else base ** alpha)
 
 
-@njit(cache=True)
+@kernel
 def dahl_update_with_slopes(force_n: float, dx_mm: float, fs_n: float, sigma_n_per_mm: float,
                             alpha: float) -> tuple:
     """dahl_update (below, which states the law) and its derivatives (F, dF/d(dx), dF/dFs).
@@ -63,7 +63,7 @@ def dahl_update_with_slopes(force_n: float, dx_mm: float, fs_n: float, sigma_n_p
         return direction * fs_n, 0.0, direction
     decay = sigma_n_per_mm * abs(dx_mm) / fs_n
     if alpha == 1.0:
-        z = z0 * math.exp(-decay)
+        z = z0 * math.exp(-decay) if decay < 40.0 else 0.0   # e^-40 ~ 4e-18: saturated
     elif alpha < 1.0:
         w = z0 ** (1.0 - alpha) - (1.0 - alpha) * decay
         z = w ** (1.0 / (1.0 - alpha)) if w > 0.0 else 0.0
@@ -80,7 +80,7 @@ def dahl_update_with_slopes(force_n: float, dx_mm: float, fs_n: float, sigma_n_p
     return force, d_dx, d_fs
 
 
-@njit(cache=True)
+@kernel
 def dahl_update(force_n: float, dx_mm: float, fs_n: float, sigma_n_per_mm: float, alpha: float) -> float:
     """Integrate paper eq. 1 exactly over a sliding increment dx [mm].
 

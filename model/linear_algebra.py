@@ -1,8 +1,8 @@
 """Small dense solves for the model's hot loop (numba): 4x4 systems, no allocation per call."""
-from numba import njit
+from model.jit import kernel
 
 
-@njit(cache=True)
+@kernel
 def solve_in_place(a, b, n: int, m: int) -> bool:
     """Solve A X = B for the leading n x n block of `a` and n x m block of `b`.
 
@@ -39,3 +39,27 @@ def solve_in_place(a, b, n: int, m: int) -> bool:
                 acc -= a[col, k] * b[k, j]
             b[col, j] = acc * inv
     return True
+
+
+@kernel
+def solve_diagonally_dominant(a, b, n: int, m: int) -> None:
+    """Solve A X = B in place like solve_in_place, without pivoting.
+
+    Valid when A is strictly diagonally dominant (Gaussian elimination then needs no row
+    exchanges and is stable), as I - K D/4 - G/2 is for the friction linearisation.
+    """
+    for col in range(n):
+        inv = 1.0 / a[col, col]
+        for row in range(col + 1, n):
+            factor = a[row, col] * inv
+            for j in range(col + 1, n):
+                a[row, j] -= factor * a[col, j]
+            for j in range(m):
+                b[row, j] -= factor * b[col, j]
+    for col in range(n - 1, -1, -1):
+        inv = 1.0 / a[col, col]
+        for j in range(m):
+            acc = b[col, j]
+            for k in range(col + 1, n):
+                acc -= a[col, k] * b[k, j]
+            b[col, j] = acc * inv

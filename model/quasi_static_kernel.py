@@ -40,13 +40,13 @@ explicit use of the previous step's friction.
 import math
 
 import numpy as np
-from numba import njit
+from model.jit import kernel
 
 from model.backbone_geometry import compose_backbone
 from model.dahl_friction import capstan_gain, dahl_update_with_slopes
 from model.effect_terms import (E_BACKLASH, E_GX, E_GY, E_GZ, E_KAPPA0_X, E_KAPPA0_Y, E_LUMEN_COEF,
                                 E_LUMEN_EXTENT, E_RATE, E_TENDON_COMPLIANCE, E_TUBE_PLAY, E_TWIST)
-from model.linear_algebra import solve_in_place
+from model.linear_algebra import solve_diagonally_dominant, solve_in_place
 
 # Positions in the kernel's parameter vector (see DahlCatheter._kernel_params).
 P_R = 0        # tendon offset r, mm
@@ -69,7 +69,7 @@ MAX_NEWTON_ITERATIONS = 12
 FORCE_TOLERANCE_N = 1e-4  # exact vs linearised Dahl force per element; 1e-4 N moves the tip < 1 um
 
 
-@njit(cache=True)
+@kernel
 def play_operator(previous: float, target: float, width: float) -> float:
     """Backlash (play) of total width w: the output follows once the input leaves the band.
 
@@ -79,7 +79,7 @@ def play_operator(previous: float, target: float, width: float) -> float:
     return min(max(previous, target - half), target + half)
 
 
-@njit(cache=True)
+@kernel
 def _element_modifiers(n, length, params, effects, tension, bend_prev, points, frames,
                        arm, angle, rest_bend, ext_bend):
     """Per-element terms from the effect vector and the previous step's state.
@@ -138,10 +138,13 @@ def _element_modifiers(n, length, params, effects, tension, bend_prev, points, f
         ext_bend[i, 1] = -local_x / kb
 
 
-@njit(cache=True)
+@kernel
 def _sweep(n, h, params, arm, cos_phi, sin_phi, ext_bend, f0, kx, gt, gth, bend_dir, xref, tref, slack,
-           lin_force, lin_tension, lin_shortening, lin_sliding, dist_force, dist_short):
-    """Tip-to-base sweep: affine maps (4 x 5: constant, then d/dT_tip) of every element quantity.
+           lin_force, dist_force, dist_short):
+    """Tip-to-base sweep: affine maps (4 x 5: constant, then d/dT_tip) of the friction forces.
+
+    Stores the map of each element's friction forces (lin_force) and returns the maps of the
+    distal sums of force and shortening over the whole catheter (dist_force, dist_short).
 
     Friction is linearised about the last iterate (x_ref, T_ref, F0):
         F = F0 + K (x - x_ref) + G (T - T_ref),   T = P + F/2,   x = S + (D T + d0)/2
@@ -154,68 +157,75 @@ def _sweep(n, h, params, arm, cos_phi, sin_phi, ext_bend, f0, kx, gt, gth, bend_
     kb = params[P_EI] / h
     ka = h / params[P_EA]
     kt = h / params[P_EAT]
-    d = np.empty((4, 4))
     a = np.empty((4, 4))
-    g = np.empty((4, 4))
     rhs = np.empty((4, 5))
     pull = np.empty((4, 5))
+    dp = np.empty((4, 5))
+    w_pull = np.empty(5)
     d0 = np.empty(4)
+    w = np.empty(4)
     dist_force[:, :] = 0.0
     dist_short[:, :] = 0.0
     for i in range(n - 1, -1, -1):
         r = arm[i]
+        c = r * r / kb
         e0 = cos_phi[i]
         e1 = sin_phi[i]
+        for m in range(4):   # dtheta/dT_m = (r/K_b) u . e_m
+            w[m] = r / kb * (bend_dir[i, 0] * e0[m] + bend_dir[i, 1] * e1[m])
         for k in range(4):
             d0[k] = r * (ext_bend[i, 0] * e0[k] + ext_bend[i, 1] * e1[k])
-            for m in range(4):
-                d[k, m] = ka + r * r / kb * (e0[k] * e0[m] + e1[k] * e1[m])
-            d[k, k] += kt
             for col in range(5):
-                pull[k, col] = (1.0 if col == k + 1 else 0.0) + dist_force[k, col]
-        for k in range(4):
-            for m in range(4):
-                dtheta = r / kb * (bend_dir[i, 0] * e0[m] + bend_dir[i, 1] * e1[m])
-                g[k, m] = gth[k, i] * dtheta + (gt[k, i] if k == m else 0.0)
+                pull[k, col] = dist_force[k, col]
+            pull[k, k + 1] += 1.0
+        _apply_d(ka, c, kt, e0, e1, pull, dp)
+        for col in range(5):
+            w_pull[col] = w[0] * pull[0, col] + w[1] * pull[1, col] + w[2] * pull[2, col] + w[3] * pull[3, col]
         for k in range(4):
             if slack[k]:
                 for m in range(4):
-                    a[k, m] = 1.0 if k == m else 0.0
+                    a[k, m] = 0.0
+                a[k, k] = 1.0
                 for col in range(5):
                     rhs[k, col] = 0.0
                 continue
             kk = kx[k, i]
+            gk = gt[k, i]
+            hk = gth[k, i]
+            # G_km = gt_k delta_km + gth_k w_m;  D_km = ka + c e_k.e_m + kt delta_km
             for m in range(4):
-                a[k, m] = (1.0 if k == m else 0.0) - 0.25 * kk * d[k, m] - 0.5 * g[k, m]
+                a[k, m] = -0.25 * kk * (ka + c * (e0[k] * e0[m] + e1[k] * e1[m])) - 0.5 * hk * w[m]
+            a[k, k] += 1.0 - 0.25 * kk * kt - 0.5 * gk
+            w_tref = w[0] * tref[0, i] + w[1] * tref[1, i] + w[2] * tref[2, i] + w[3] * tref[3, i]
             for col in range(5):
-                acc = 0.0
-                acc_g = 0.0
-                for m in range(4):
-                    acc += d[k, m] * pull[m, col]
-                    acc_g += g[k, m] * (pull[m, col] - (tref[m, i] if col == 0 else 0.0))
-                value = kk * (dist_short[k, col] + 0.5 * acc) + acc_g
-                if col == 0:
-                    value += f0[k, i] + kk * (0.5 * d0[k] - xref[k, i])
-                rhs[k, col] = value
-        solve_in_place(a, rhs, 4, 5)
+                rhs[k, col] = kk * (dist_short[k, col] + 0.5 * dp[k, col]) + gk * pull[k, col] + hk * w_pull[col]
+            rhs[k, 0] += f0[k, i] + kk * (0.5 * d0[k] - xref[k, i]) - gk * tref[k, i] - hk * w_tref
+        solve_diagonally_dominant(a, rhs, 4, 5)
         for k in range(4):
             for col in range(5):
-                lin_force[i, k, col] = rhs[k, col]
-                lin_tension[i, k, col] = pull[k, col] + 0.5 * rhs[k, col]
+                force = rhs[k, col]
+                lin_force[i, k, col] = force
+                pull[k, col] += 0.5 * force       # now the element's mean tension T = P + F/2
+                dist_force[k, col] += force
+        _apply_d(ka, c, kt, e0, e1, pull, dp)
         for k in range(4):
             for col in range(5):
-                acc = d0[k] if col == 0 else 0.0
-                for m in range(4):
-                    acc += d[k, m] * lin_tension[i, m, col]
-                lin_shortening[i, k, col] = acc
-                lin_sliding[i, k, col] = dist_short[k, col] + 0.5 * acc
-        for k in range(4):
-            for col in range(5):
-                dist_force[k, col] += lin_force[i, k, col]
-                dist_short[k, col] += lin_shortening[i, k, col]
+                dist_short[k, col] += dp[k, col]
+            dist_short[k, 0] += d0[k]
 
 
-@njit(cache=True)
+@kernel
+def _apply_d(ka, c, kt, e0, e1, x, out):
+    """out = D x for the element compliance D = ka*J + c*E E^T + kt*I (J all ones, E = [e0 e1])."""
+    for col in range(x.shape[1]):
+        total = x[0, col] + x[1, col] + x[2, col] + x[3, col]
+        along0 = e0[0] * x[0, col] + e0[1] * x[1, col] + e0[2] * x[2, col] + e0[3] * x[3, col]
+        along1 = e1[0] * x[0, col] + e1[1] * x[1, col] + e1[2] * x[2, col] + e1[3] * x[3, col]
+        for k in range(4):
+            out[k, col] = ka * total + c * (e0[k] * along0 + e1[k] * along1) + kt * x[k, col]
+
+
+@kernel
 def _tip_tensions(u, compliance, dist_force, dist_short, slack, revived, tip_tension):
     """Compatibility with slack tendons: a 4-variable complementarity problem, by active set.
 
@@ -283,12 +293,12 @@ def _tip_tensions(u, compliance, dist_force, dist_short, slack, revived, tip_ten
     return changed
 
 
-@njit(cache=True)
+@kernel
 def _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_per_step, friction, increment, tension,
-                       f0, kx, gt, gth, bend_dir):
+                       slack, f0, kx, gt, gth, bend_dir):
     """Exact Dahl forces of element i after the sliding `increment`, and their derivatives.
 
-    Fs = s*(Fsc + gain(theta)*T) with gain = 2 tanh(mu theta/2) (capstan_gain) and the
+    Slack tendons get zeros. Fs = s*(Fsc + gain(theta)*T) with gain = 2 tanh(mu theta/2) (capstan_gain) and the
     rate-friction scale s = 1 + c_rate*|v|, v = increment/dt (rate_per_step = c_rate/dt). Returns, per tendon, F0 = dahl_update(...), dF/dx, gt = dF/dFs * s*gain (own
     tension), gth = dF/dFs * s*T*dgain/dtheta with dgain/dtheta = mu*(1 - tanh^2(mu theta/2)).
     """
@@ -302,6 +312,12 @@ def _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_per_step, friction
         bend_dir[i, 0] = 0.0
         bend_dir[i, 1] = 0.0
     for k in range(4):
+        if slack[k]:       # a slack tendon carries no friction
+            f0[k, i] = 0.0
+            kx[k, i] = 0.0
+            gt[k, i] = 0.0
+            gth[k, i] = 0.0
+            continue
         s = 1.0 + rate_per_step * abs(increment[k, i])
         t = max(tension[k, i], 0.0)
         fs = s * (fsc + gain * t)
@@ -314,18 +330,18 @@ def _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_per_step, friction
         gth[k, i] = d_fs * s * t * dgain
 
 
-@njit(cache=True)
+@kernel
 def make_workspace(n):
     """Scratch arrays for quasi_static_step, allocated once per run."""
     return (np.empty(n), np.empty(n), np.empty((n, 2)), np.empty((n, 2)), np.empty((n, 4)), np.empty((n, 4)),
             np.empty((4, n)), np.empty((4, n)), np.empty((4, n)), np.empty((4, n)), np.empty((n, 2)),
-            np.empty((4, n)), np.empty((4, n)), np.empty((n, 4, 5)), np.empty((n, 4, 5)), np.empty((n, 4, 5)),
-            np.empty((n, 4, 5)), np.empty((4, 5)), np.empty((4, 5)), np.empty((4, n)), np.empty((4, n)),
+            np.empty((4, n)), np.empty((4, n)), np.empty((n, 4, 5)), np.empty(4), np.empty(4),
+            np.empty((4, 5)), np.empty((4, 5)), np.empty((4, n)), np.empty((4, n)),
             np.empty((4, n)), np.empty((n, 2)), np.empty(n), np.empty((4, n)), np.empty(4),
             np.zeros(4, dtype=np.bool_), np.empty(n))
 
 
-@njit(cache=True)
+@kernel
 def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_step, tension,
                       bend, compression, tip_tension, drive_tension, slack, points, frames, scalars, work):
     """Advance the catheter state to equilibrium at tendon input u [mm] and free length [mm].
@@ -345,7 +361,7 @@ def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_
     rate_per_step = effects[E_RATE] / dt_s if (dt_s > 0.0 and math.isfinite(dt_s)) else 0.0
 
     (arm, angle, rest_bend, ext_bend, cos_phi, sin_phi, f0, kx, gt, gth, bend_dir, xref, tref, lin_force,
-     lin_tension, lin_shortening, lin_sliding, dist_force, dist_short, new_force, new_sliding, new_tension,
+     distal_force, distal_short, dist_force, dist_short, new_force, new_sliding, new_tension,
      new_bend, new_compression, increment, linear_force, revived, lengths) = work
     _element_modifiers(n, length, params, effects, tension, bend, points, frames,
                        arm, angle, rest_bend, ext_bend)
@@ -361,7 +377,7 @@ def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_
     tref[:, :] = tension
     for i in range(n):
         _linearise_element(i, bend[i, 0], bend[i, 1], mu, fsc, sigma, alpha, rate_per_step, friction,
-                           last_step, tension, f0, kx, gt, gth, bend_dir)
+                           last_step, tension, slack, f0, kx, gt, gth, bend_dir)
         for k in range(4):
             xref[k, i] = sliding[k, i] + last_step[k, i]
 
@@ -371,46 +387,50 @@ def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_
     for iteration in range(MAX_NEWTON_ITERATIONS):
         scalars[S_ITERATIONS] += 1.0
         _sweep(n, h, params, arm, cos_phi, sin_phi, ext_bend, f0, kx, gt, gth, bend_dir, xref, tref, slack,
-               lin_force, lin_tension, lin_shortening, lin_sliding, dist_force, dist_short)
+               lin_force, dist_force, dist_short)
         if _tip_tensions(u, compliance, dist_force, dist_short, slack, revived, tip_tension):
             continue
         worst = 0.0
-        for i in range(n):
+        ka = h / params[P_EA]
+        kt = h / params[P_EAT]
+        for k in range(4):
+            distal_force[k] = 0.0
+            distal_short[k] = 0.0
+        for i in range(n - 1, -1, -1):   # tip to base: tensions add the distal friction forces
             r = arm[i]
+            c = r * r / kb
             bx = rest_bend[i, 0] + ext_bend[i, 0]
             by = rest_bend[i, 1] + ext_bend[i, 1]
             total = 0.0
+            along0 = 0.0
+            along1 = 0.0
             for k in range(4):
-                t = lin_tension[i, k, 0]
-                x = lin_sliding[i, k, 0]
-                for m in range(4):
-                    t += lin_tension[i, k, m + 1] * tip_tension[m]
-                    x += lin_sliding[i, k, m + 1] * tip_tension[m]
-                new_tension[k, i] = t
-                new_sliding[k, i] = x
-                bx += r / kb * t * cos_phi[i, k]
-                by += r / kb * t * sin_phi[i, k]
-                total += t
-            new_bend[i, 0] = bx
-            new_bend[i, 1] = by
-            new_compression[i] = h / params[P_EA] * total
-            for k in range(4):
-                if slack[k]:
-                    linear_force[k] = 0.0
-                    continue
                 linear = lin_force[i, k, 0]
                 for m in range(4):
                     linear += lin_force[i, k, m + 1] * tip_tension[m]
-                increment[k, i] = new_sliding[k, i] - sliding[k, i]
                 linear_force[k] = linear
-            _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_per_step, friction, increment,
-                               new_tension, f0, kx, gt, gth, bend_dir)
+                t = tip_tension[k] + distal_force[k] + 0.5 * linear
+                new_tension[k, i] = t
+                total += t
+                along0 += t * cos_phi[i, k]
+                along1 += t * sin_phi[i, k]
+            bx += r / kb * along0
+            by += r / kb * along1
+            new_bend[i, 0] = bx
+            new_bend[i, 1] = by
+            new_compression[i] = ka * total
             for k in range(4):
-                if slack[k]:
-                    f0[k, i] = 0.0
-                    kx[k, i] = 0.0
-                    gt[k, i] = 0.0
-                    gth[k, i] = 0.0
+                # delta = D T + d0 with D = ka*J + (r^2/K_b) E E^T + kt*I
+                shortening = (ka * total + c * (cos_phi[i, k] * along0 + sin_phi[i, k] * along1)
+                              + kt * new_tension[k, i]
+                              + r * (ext_bend[i, 0] * cos_phi[i, k] + ext_bend[i, 1] * sin_phi[i, k]))
+                new_sliding[k, i] = distal_short[k] + 0.5 * shortening
+                distal_short[k] += shortening
+                distal_force[k] += linear_force[k]
+                increment[k, i] = new_sliding[k, i] - sliding[k, i]
+            _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_per_step, friction, increment,
+                               new_tension, slack, f0, kx, gt, gth, bend_dir)
+            for k in range(4):
                 new_force[k, i] = f0[k, i]
                 worst = max(worst, abs(f0[k, i] - linear_force[k]))
                 xref[k, i] = new_sliding[k, i]
@@ -438,7 +458,7 @@ def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_
     compose_backbone(bend, lengths, points, frames)
 
 
-@njit(cache=True)
+@kernel
 def remap_to_length(old_length, new_length, friction, sliding, last_step, tension):
     """Carry the friction state along the material when the free length changes.
 
@@ -482,7 +502,7 @@ def remap_to_length(old_length, new_length, friction, sliding, last_step, tensio
                 tension[k, i] = (1 - w) * old_tension[k, j0] + w * old_tension[k, j0 + 1]
 
 
-@njit(cache=True)
+@kernel
 def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_step_mm, params, effects,
              applied_tendon_mm, applied_insertion_mm, friction, sliding, last_step, tension, bend,
              compression, tip_tension, drive_tension, slack, points, frames, scalars, tips_out):

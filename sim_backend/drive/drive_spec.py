@@ -22,6 +22,13 @@ from pathlib import Path
 class DriveSpec:
     """One axis' drive. Lengths in mm of tendon or pulley travel, times in s.
 
+    ``max_velocity_mm_s`` and ``max_acceleration_mm_s2`` are the axis limits: the
+    drive's profile defaults (0x6081, 0x6083, 0x6084, 0x6085) use them. The motor
+    can do ``motor_velocity_reserve`` and ``motor_acceleration_reserve`` times
+    more (a servo is sized with speed and torque reserve), so it can follow a
+    profile at the axis limits; a demand beyond what the motor can do is followed
+    with a lag.
+
     ``negative_limit_switch_mm`` places the simulated negative limit switch (None:
     no switch wired, so homing method 17 ends in a homing error). Put it at
     ``home_position_mm`` so that homing on it makes the drive report the plant's
@@ -42,6 +49,8 @@ class DriveSpec:
     rated_torque_mnm: float
     following_error_window_mm: float
     following_error_timeout_s: float = 0.05
+    motor_velocity_reserve: float = 1.25
+    motor_acceleration_reserve: float = 2.0
     position_window_mm: float = 0.02
     home_position_mm: float = 0.0
     negative_limit_switch_mm: float | None = None
@@ -58,7 +67,8 @@ class DriveSpec:
         if not 1 <= self.master_node_id <= 127 or self.master_node_id == self.node_id:
             raise ValueError(f"{where}: master_node_id must be 1..127 and differ from the drive's node id")
         for field_name in ("encoder_counts_per_rev", "gear_ratio", "drum_radius_mm", "max_velocity_mm_s",
-                           "max_acceleration_mm_s2", "rated_torque_mnm", "following_error_window_mm",
+                           "max_acceleration_mm_s2", "rated_torque_mnm",
+                           "motor_velocity_reserve", "motor_acceleration_reserve", "following_error_window_mm",
                            "position_window_mm", "heartbeat_period_s", "heartbeat_timeout_s", "cycle_period_s"):
             if not getattr(self, field_name) > 0:
                 raise ValueError(f"{where}: {field_name} must be > 0, got {getattr(self, field_name)!r}")

@@ -9,7 +9,8 @@ Controlword bits of this mode:
 
 Statusword bits of this mode:
     bit 10 target reached       the profile has ended (or halted) and the actual
-                                position is within the position window 0x6067
+                                position has stayed within the position window
+                                0x6067 for the position window time 0x6068
     bit 12 set-point acknowledge  1 after a set-point was taken; it drops when
                                 bit 4 is cleared and the buffer can take another one
     bit 13 following error      set by the drive's following-error monitor
@@ -98,12 +99,10 @@ class ProfilePosition:
             if not self._new_set_point_bit:
                 self.acknowledged = False
 
-    def statusword_bits(self, demand: SetpointGenerator, actual_counts: float,
-                        position_window_counts: float) -> int:
-        """Bits 10 (target reached) and 12 (set-point acknowledge)."""
+    def statusword_bits(self, demand: SetpointGenerator, settled: bool) -> int:
+        """Bits 10 (target reached) and 12 (set-point acknowledge); ``settled``: in the window long enough."""
         profile_done = demand.is_stopped and (self.halted or self.active_target_counts is None)
-        in_window = abs(demand.position_counts - actual_counts) <= position_window_counts
-        bits = TARGET_REACHED_BIT if profile_done and in_window else 0
+        bits = TARGET_REACHED_BIT if profile_done and settled else 0
         if self.acknowledged:
             bits |= SET_POINT_ACKNOWLEDGE_BIT
         return bits

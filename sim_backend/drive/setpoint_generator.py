@@ -58,7 +58,7 @@ class SetpointGenerator:
             self.sync(target_counts)
             return True
         d_dt = deceleration_counts_s2 * dt_s
-        toward = math.copysign(v, error)
+        toward = v if error > 0 else -v  # speed toward the target (negative: moving away)
         discriminant = d_dt * d_dt + 8.0 * deceleration_counts_s2 * abs(error) - 4.0 * d_dt * toward
         reachable = 0.5 * (-d_dt + math.sqrt(max(discriminant, 0.0)))
         goal = math.copysign(min(max_velocity_counts_s, max(reachable, 0.0)), error)

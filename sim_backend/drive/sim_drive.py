@@ -83,7 +83,8 @@ class SimDrive:
         self.node.add_write_callback(self._validate_write)
         self._process_data = ProcessData(self.node, send=self._send, on_rpdo=self._on_rpdo,
                                          on_length_error=self._on_pdo_length_error)
-        self._servo = ServoAxis(spec.to_counts(spec.max_velocity_mm_s), spec.to_counts(spec.max_acceleration_mm_s2),
+        self._servo = ServoAxis(spec.to_counts(spec.max_velocity_mm_s * spec.motor_velocity_reserve),
+                                spec.to_counts(spec.max_acceleration_mm_s2 * spec.motor_acceleration_reserve),
                                 position_counts=spec.to_counts(spec.start_position_mm))
         self._demand = SetpointGenerator(self._servo.position_counts)
         self._state_machine = Cia402StateMachine()
@@ -97,6 +98,7 @@ class SimDrive:
         self._load_tension_n = 0.0
         self._internal_limit = False
         self._following_error_s = 0.0
+        self._in_position_window_s = 0.0
         self._powered = False
         self.silent = False
         self.sdo_silent = False
@@ -405,6 +407,7 @@ class SimDrive:
             self._following_error_s = 0.0
         elif was not in ENERGISED_STATES:
             self._demand.sync(self._servo.position_counts)
+            self._in_position_window_s = self.node.value(0x6068) / 1000.0  # at rest on the demand: settled
         self._profile_position.reset(self._demand.position_counts)
         self._homing.interrupt()
         if was is DriveState.FAULT:
@@ -488,6 +491,7 @@ class SimDrive:
         if state not in ENERGISED_STATES:
             return
         self._servo.step(self._demand.position_counts, self._demand.velocity_counts_s, dt_s)
+        self._check_position_window(dt_s)
         self._check_following_error(dt_s)
         if (self._state_machine.state is DriveState.QUICK_STOP_ACTIVE and self._demand.is_stopped
                 and self.node.value(0x605A) in (1, 2, 3, 4)):
@@ -514,6 +518,17 @@ class SimDrive:
     def _following_error_counts(self) -> float:
         return self._demand.position_counts - self._servo.position_counts
 
+    def _check_position_window(self, dt_s: float) -> None:
+        """Time the actual position has stayed within the position window 0x6067 of the demand."""
+        if abs(self._following_error_counts()) <= self.node.value(0x6067):
+            self._in_position_window_s += dt_s
+        else:
+            self._in_position_window_s = 0.0
+
+    def _settled(self) -> bool:
+        """In the position window for at least the position window time 0x6068."""
+        return self._in_position_window_s >= self.node.value(0x6068) / 1000.0 - 1e-9
+
     def _check_following_error(self, dt_s: float) -> None:
         """CiA 402: |demand - actual| > 0x6065 for longer than 0x6066 ms is a fault (EMCY 0x8611)."""
         window = self.node.value(0x6065)
@@ -536,8 +551,7 @@ class SimDrive:
             return statusword
         mode = self._mode()
         if mode == MODE_PROFILE_POSITION:
-            statusword |= self._profile_position.statusword_bits(
-                self._demand, self._servo.position_counts, self.node.value(0x6067))
+            statusword |= self._profile_position.statusword_bits(self._demand, self._settled())
         elif mode == MODE_CYCLIC_SYNC_POSITION:
             statusword |= FOLLOWS_COMMAND_BIT
         elif mode == MODE_HOMING:

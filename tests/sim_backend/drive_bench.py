@@ -133,6 +133,18 @@ class DriveBench:
         self.barrier(name)
         return node
 
+    def enable(self, name: str, mode: int) -> BaseNode402:
+        """OPERATIONAL, mode of operation set, and OPERATION ENABLED (by SDO)."""
+        node = self.operational(name)
+        node.sdo[0x6060].raw = mode
+        self.controlword(name, 0x06)
+        assert self.controlword(name, 0x0F) & 0x6F == 0x27, "drive did not reach OPERATION ENABLED"
+        return node
+
+    def tpdo1(self, name: str) -> dict[int, int]:
+        """Last TPDO1 the client received from a drive, decoded by canopen: {index: value}."""
+        return {variable.index: variable.raw for variable in self.nodes[name].tpdo[1].map}
+
     def controlword(self, name: str, value: int) -> int:
         """Write 0x6040 by SDO and read back the statusword 0x6041 by SDO."""
         node = self.nodes[name]

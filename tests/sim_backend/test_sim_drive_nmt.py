@@ -31,10 +31,10 @@ def test_nmt_reset_sends_boot_up_and_returns_to_pre_operational(bench, command):
     node.nmt.send_command(0x01)
     bench.barrier()
     assert bench.drive("tendon1").nmt_state == "OPERATIONAL"
-    node.nmt.wait_for_bootup  # the client's own boot-up wait is used below
     bench.recorder.clear()
     node.nmt.send_command(command)
-    node.nmt.wait_for_bootup(timeout=2.0)
+    bench.recorder.wait_for(lambda frames: boot_ups(bench, 1), "boot-up after reset")
+    bench.barrier("insertion")
     assert bench.drive("tendon1").nmt_state == "PRE-OPERATIONAL"
     assert len(boot_ups(bench, 1)) == 1
     assert boot_ups(bench, 5) == []  # addressed to node 1 only
@@ -44,12 +44,10 @@ def test_reset_node_restores_written_objects_but_reset_communication_keeps_appli
     node = bench.nodes["tendon1"]
     node.sdo[0x6081].raw = 1234
     node.sdo[0x1017].raw = 500
-    node.nmt.send_command(0x82)
-    node.nmt.wait_for_bootup(timeout=2.0)
+    node.nmt.send_command(0x82)  # SDOs below are processed after the reset
     assert node.sdo[0x6081].raw == 1234
     assert node.sdo[0x1017].raw == 50
     node.nmt.send_command(0x81)
-    node.nmt.wait_for_bootup(timeout=2.0)
     assert node.sdo[0x6081].raw == round(20.0 * bench.drive("tendon1").spec.counts_per_mm)
 
 

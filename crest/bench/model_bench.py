@@ -1,0 +1,63 @@
+"""Benchmarks of the model: step rate, real-time factor, cost against N, one quasi-static move."""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from model import CatheterParams, DahlCatheter, tendons_from_articulation
+
+SAMPLE_RATE_HZ = 100.0
+
+
+def articulation_path(params: CatheterParams, duration_s: float = 10.0, peak_deg: float = 150.0) -> np.ndarray:
+    """A 100 Hz articulation to peak_deg and back over duration_s: tendon set-points [T, 4]."""
+    n = int(duration_s * SAMPLE_RATE_HZ)
+    theta = np.deg2rad(peak_deg) * np.sin(np.linspace(0.0, np.pi, n))
+    return np.array([tendons_from_articulation(t, 0.0, params.tendon_offset_mm, 0.02) for t in theta])
+
+
+def time_run_s(params: CatheterParams, n_elements: int, path: np.ndarray, repeats: int = 3) -> float:
+    """Best wall time of `run` over the path (after one warm-up that also compiles)."""
+    model = DahlCatheter(params, n_elements)
+    model.run(path[:10])
+    best = np.inf
+    for _ in range(repeats):
+        model.reset()
+        start = time.perf_counter()
+        model.run(path)
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
+def model_step(params: CatheterParams) -> dict:
+    """Real-time factor at N = 20: seconds of 100 Hz input simulated per wall-clock second."""
+    path = articulation_path(params)
+    wall_s = time_run_s(params, 20, path)
+    duration_s = len(path) / SAMPLE_RATE_HZ
+    return {"n_elements": 20, "samples": len(path), "wall_s": wall_s,
+            "step_rate_hz": len(path) / wall_s, "real_time_factor": duration_s / wall_s,
+            "goal_real_time_factor": 1000.0}
+
+
+def scaling_in_n(params: CatheterParams, sizes=(10, 20, 40, 80, 160, 320)) -> dict:
+    """Cost per sample against N and the exponent p of cost ~ N^p (least squares in log-log)."""
+    path = articulation_path(params, duration_s=4.0)
+    per_sample_us = [time_run_s(params, n, path, repeats=2) / len(path) * 1e6 for n in sizes]
+    exponent = float(np.polyfit(np.log(sizes), np.log(per_sample_us), 1)[0])
+    return {"n_elements": list(sizes), "per_sample_us": per_sample_us, "cost_exponent": exponent,
+            "goal_cost_exponent": 1.1}
+
+
+def quasi_static_move(params: CatheterParams) -> dict:
+    """Wall time of one move_to from 0 to 180 deg (sub-stepped to follow the friction history)."""
+    model = DahlCatheter(params)
+    target = tendons_from_articulation(np.pi, 0.0, params.tendon_offset_mm, 0.02)
+    model.move_to(target)
+    times = []
+    for _ in range(5):
+        model.reset()
+        start = time.perf_counter()
+        model.move_to(target)
+        times.append(time.perf_counter() - start)
+    return {"from_deg": 0, "to_deg": 180, "wall_ms": 1e3 * min(times)}

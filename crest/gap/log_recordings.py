@@ -1,0 +1,35 @@
+"""Turn crest-log/1 experiment logs into the arrays the gap analysis works on."""
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from crest.log import ExperimentLog, read_log
+from model.gap.recording import Recording, RecordingError
+
+MODEL_TENDON_ANGLES_DEG = (0.0, 90.0, 180.0, 270.0)
+
+
+def recording_from_log(log: ExperimentLog) -> Recording:
+    """The log's measured positions, tips, forces and catheter geometry as a Recording.
+
+    The model's tendons sit at 0, 90, 180, 270 deg; a log with other tendon angles is refused.
+    """
+    angles = np.mod(np.asarray(log.catheter["tendon_angles_deg"], dtype=float), 360.0)
+    if not np.allclose(angles, MODEL_TENDON_ANGLES_DEG, atol=1e-6):
+        raise RecordingError(f"{log.path}: catheter.tendon_angles_deg is {log.catheter['tendon_angles_deg']}; "
+                             f"the model needs tendons at {list(MODEL_TENDON_ANGLES_DEG)} (reorder the tendon "
+                             "columns when importing)")
+    return Recording(name=Path(log.path).name, t_s=np.asarray(log.t_s), tendon_mm=np.asarray(log.tendon_pos_mm),
+                     insertion_mm=np.asarray(log.insertion_pos_mm), tip_mm=np.asarray(log.tip_mm),
+                     tendon_force_n=None if log.tendon_force_n is None else np.asarray(log.tendon_force_n),
+                     flexible_length_mm=float(log.catheter["flexible_length_mm"]),
+                     tendon_offset_mm=float(log.catheter["tendon_offset_mm"]),
+                     outer_diameter_mm=log.catheter["outer_diameter_mm"])
+
+
+def load_recordings(paths: Sequence[Path | str]) -> list[Recording]:
+    """Read and convert each log (LogFormatError / RecordingError name the file)."""
+    return [recording_from_log(read_log(path)) for path in paths]

@@ -1,0 +1,74 @@
+"""Record crest logs from a model plant: the stand-in for `crest excite` on the virtual testbed.
+
+The plant is a fine DahlCatheter (20 elements) with its own base parameters, tendon zero
+offsets and any candidate effects switched on. The drives follow the set-points exactly and
+report them at encoder resolution; the tracker adds Gaussian noise and drops samples; the
+drive tension is reported with noise. The log records only what a testbed would: which
+effect the plant has is never written (the sidecar says "model plant", nothing more).
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from control.excitation import Trajectory
+from crest.log import LogWriter, catheter_dict
+from model import CatheterParams, DahlCatheter
+from model.effects import combined_terms
+
+# 4096 counts/rev, gear 10, 5 mm drum (configs/testbed.toml): tendon position resolution.
+TENDON_ENCODER_STEP_MM = 2 * math.pi * 5.0 / (4096 * 10.0)
+# 4096 counts/rev, gear 20, 8 mm pulley.
+INSERTION_ENCODER_STEP_MM = 2 * math.pi * 8.0 / (4096 * 20.0)
+
+
+@dataclass(frozen=True)
+class SensorNoise:
+    """Measurement imperfections of the virtual testbed (per axis std in mm, force std in N)."""
+
+    tip_mm: float = 0.1
+    dropout_fraction: float = 0.01
+    tendon_force_n: float = 0.05
+
+
+@dataclass(frozen=True)
+class Plant:
+    """The catheter behind the drives: base parameters, zero offsets and effects {id: values}."""
+
+    params: CatheterParams
+    effects: Mapping[str, tuple[float, ...]] = field(default_factory=dict)
+    zero_offsets_mm: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
+    n_elements: int = 20
+
+
+def record_plant_log(path: Path | str, trajectory: Trajectory, plant: Plant, noise: SensorNoise,
+                     rng: np.random.Generator, *, overwrite: bool = False) -> Path:
+    """Drive the plant along the trajectory and write what the testbed would log; returns the CSV path."""
+    tendon_pos = np.round(trajectory.tendon_mm / TENDON_ENCODER_STEP_MM) * TENDON_ENCODER_STEP_MM
+    insertion_pos = np.round(trajectory.insertion_mm / INSERTION_ENCODER_STEP_MM) * INSERTION_ENCODER_STEP_MM
+    params = plant.params.replace(free_length_mm=float(insertion_pos[0]))
+    catheter = DahlCatheter(params, plant.n_elements, combined_terms(plant.effects))
+    u = tendon_pos - np.asarray(plant.zero_offsets_mm)
+    dt_s = float(trajectory.t_s[1] - trajectory.t_s[0])
+    n = len(trajectory.t_s)
+    tips = np.empty((n, 3))
+    force = np.empty((n, 4))
+    for t in range(n):
+        tips[t] = catheter.run(u[t:t + 1], insertion_pos[t:t + 1], dt_s)[0]
+        force[t] = catheter.drive_tension_n
+    tips += rng.normal(0.0, noise.tip_mm, tips.shape)
+    tips[rng.random(n) < noise.dropout_fraction] = np.nan
+    force += rng.normal(0.0, noise.tendon_force_n, force.shape)
+    sidecar_catheter = catheter_dict(flexible_length_mm=plant.params.max_free_length_mm,
+                                     tendon_offset_mm=plant.params.tendon_offset_mm,
+                                     outer_diameter_mm=plant.params.outer_diameter_mm)
+    with LogWriter(path, catheter=sidecar_catheter, sample_rate_hz=1.0 / dt_s, source="model plant",
+                   notes=f"excitation: {trajectory.name}", tendon_force=True, overwrite=overwrite) as writer:
+        for t in range(n):
+            writer.write(trajectory.t_s[t], trajectory.tendon_mm[t], trajectory.insertion_mm[t], tendon_pos[t],
+                         insertion_pos[t], None if np.isnan(tips[t, 0]) else tips[t], tendon_force_n=force[t])
+    return writer.path

@@ -1,0 +1,170 @@
+"""Calibration: fit the Dahl model (and optionally candidate effects) to measured tips.
+
+Least squares over the tip error of every valid sample of the training recordings,
+
+    minimise  sum_t |tip_model(t; p) - tip_measured(t)|^2,   p in bounds,
+
+with the model driven by the measured tendon and insertion positions (scipy.optimize.least_squares,
+trust-region reflective, forward-difference Jacobian), warm-started from the given parameters.
+
+Uncertainty from the Jacobian J at the solution (in the optimisation variables z):
+
+    cov_z = s^2 (J^T J)^+,   s^2 = |r|^2 / (m - n),
+
+m residuals, n parameters. It assumes independent residuals; tip errors are correlated in time,
+so the standard deviations are a lower bound. The correlation matrix shows which parameters
+trade off (e.g. EI and mu: friction is proportional to mu * tension and tension to EI).
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from model.effects.catalog import combined_terms, effect
+from model.gap.free_parameters import ParameterLayout
+from model.gap.recording import Recording
+from model.gap.simulation import Resolution, catheter_for, predict_tips
+from model.params import CatheterParams
+
+DIFF_STEP = 0.02       # relative finite-difference step: far above the kernel's ~1 um solver noise
+TOLERANCE = 1e-4       # relative change of cost / parameters at which the fit stops
+
+
+@dataclass(frozen=True)
+class ModelFit:
+    """A fitted model: parameters, tendon zero offsets, effect values and their statistics.
+
+    names/values/std: every fitted parameter (physical units, std a lower bound, see module doc);
+    correlation: [n, n]; flags: parameters at a fit bound or outside their physical range.
+    """
+
+    params: CatheterParams
+    zero_offsets_mm: tuple[float, ...]
+    effects: dict[str, tuple[float, ...]]
+    names: tuple[str, ...] = ()
+    values: tuple[float, ...] = ()
+    std: tuple[float, ...] = ()
+    correlation: tuple[tuple[float, ...], ...] = ()
+    flags: tuple[str, ...] = ()
+    train_rmse_mm: float = math.nan
+    model_runs: int = 0
+    extra: dict = field(default_factory=dict)
+
+    def terms(self):
+        """The model's EffectTerms with the fitted effects switched on."""
+        return combined_terms(self.effects)
+
+    def effect_params(self) -> dict[str, dict[str, float]]:
+        """{effect id: {parameter name: value}}."""
+        return {effect_id: dict(zip(effect(effect_id).param_names, values))
+                for effect_id, values in self.effects.items()}
+
+    def strongest_correlations(self, threshold: float = 0.9) -> list[tuple[str, str, float]]:
+        """Pairs of fitted parameters with |correlation| above threshold, strongest first."""
+        pairs = [(self.names[i], self.names[j], self.correlation[i][j])
+                 for i in range(len(self.names)) for j in range(i + 1, len(self.names))
+                 if abs(self.correlation[i][j]) >= threshold]
+        return sorted(pairs, key=lambda pair: -abs(pair[2]))
+
+    def as_dict(self) -> dict:
+        """Plain JSON-able description (parameters with std, correlations, flags, full catheter)."""
+        catheter = {name: (list(value) if isinstance(value, tuple) else value)
+                    for name, value in vars(self.params).items()}
+        return {"parameters": {name: {"value": value, "std": std}
+                               for name, value, std in zip(self.names, self.values, self.std)},
+                "tendon_zero_offsets_mm": list(self.zero_offsets_mm),
+                "effects": self.effect_params(),
+                "strong_correlations": [{"a": a, "b": b, "correlation": c}
+                                        for a, b, c in self.strongest_correlations()],
+                "flags": list(self.flags),
+                "train_rmse_mm": self.train_rmse_mm,
+                "catheter": catheter}
+
+    @classmethod
+    def from_dict(cls, data: Mapping) -> "ModelFit":
+        """The model part of `as_dict` (catheter, zero offsets, effects) back as a ModelFit."""
+        catheter = dict(data["catheter"])
+        catheter["tendon_range_mm"] = tuple(catheter["tendon_range_mm"])
+        effects = {effect_id: effect(effect_id).values_from(values) for effect_id, values in data["effects"].items()}
+        return cls(CatheterParams(**catheter), tuple(data["tendon_zero_offsets_mm"]), effects)
+
+
+def rmse_mm(errors: Sequence[np.ndarray]) -> float:
+    """Root mean square of the Euclidean tip error over all samples of all arrays [n_i, 3]."""
+    stacked = np.concatenate([np.asarray(e).reshape(-1, 3) for e in errors])
+    return float(np.sqrt(np.mean(np.sum(stacked ** 2, axis=1))))
+
+
+def tip_errors(fit: ModelFit, recordings: Sequence[Recording], resolution: Resolution) -> list[np.ndarray]:
+    """Model minus measured tip [n_valid, 3] per recording (recordings already at the fit resolution)."""
+    terms = fit.terms()
+    zero = np.asarray(fit.zero_offsets_mm)
+    return [(predict_tips(fit.params, terms, zero, r, resolution) - r.tip_mm)[r.valid] for r in recordings]
+
+
+def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: CatheterParams | None = None,
+              zero_offsets_mm: Sequence[float] = (0.0, 0.0, 0.0, 0.0),
+              effects: Mapping[str, Sequence[float]] | None = None, fit_base: bool = True,
+              resolution: Resolution = Resolution(), max_iterations: int = 30,
+              on_evaluation: Callable[[int], None] | None = None) -> ModelFit:
+    """Fit the base parameters (unless fit_base is False) and the given effects' parameters.
+
+    recordings: training recordings at full rate (decimated here to `resolution.fit_rate_hz`).
+    start: warm start; its geometry is replaced by the recordings'. prior: the catheter the
+    physical ranges refer to (default: start). effects: {effect id: starting values}.
+    Returns a new ModelFit; `start` is unchanged.
+    """
+    prepared = resolution.prepare(recordings)
+    start = catheter_for(start, prepared)
+    prior = catheter_for(prior or start, prepared)
+    effects = {effect_id: tuple(values) for effect_id, values in (effects or {}).items()}
+    layout = ParameterLayout(prior, tuple(effects), fit_base)
+    zero_start = np.asarray(zero_offsets_mm, dtype=float)
+    runs = 0
+
+    def residuals(z: np.ndarray) -> np.ndarray:
+        nonlocal runs
+        params, zero, values = layout.unpack(z, start, zero_start)
+        terms = combined_terms(values)
+        out = [((predict_tips(params, terms, zero, r, resolution) - r.tip_mm)[r.valid]).ravel() for r in prepared]
+        runs += 1
+        if on_evaluation is not None:
+            on_evaluation(runs)
+        return np.concatenate(out)
+
+    z0 = layout.pack(start, zero_start, effects)
+    low, high = layout.bounds()
+    result = least_squares(residuals, z0, bounds=(low, high), method="trf", diff_step=DIFF_STEP,
+                           ftol=TOLERANCE, xtol=TOLERANCE, gtol=1e-8, max_nfev=max_iterations, verbose=2)
+    params, zero, values = layout.unpack(result.x, start, zero_start)
+    std_z, correlation = _statistics(result.jac, result.fun, len(result.x))
+    physical = np.array([p.from_z(z) for p, z in zip(layout.parameters, result.x)])
+    std = np.array([abs(p.from_z(z + s) - p.from_z(z)) if np.isfinite(s) else math.inf
+                    for p, z, s in zip(layout.parameters, result.x, std_z)])
+    flags = tuple(f for p, v in zip(layout.parameters, physical) if (f := p.flag(float(v))) is not None)
+    train_rmse = float(np.sqrt(np.sum(result.fun ** 2) / max(1, len(result.fun) // 3)))
+    return ModelFit(params=params, zero_offsets_mm=tuple(float(v) for v in zero), effects=values,
+                    names=layout.names, values=tuple(float(v) for v in physical), std=tuple(float(s) for s in std),
+                    correlation=tuple(tuple(float(c) for c in row) for row in correlation), flags=flags,
+                    train_rmse_mm=train_rmse, model_runs=runs)
+
+
+def _statistics(jac: np.ndarray, fun: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Standard deviations and correlation matrix of z from the Jacobian (see module doc)."""
+    m = len(fun)
+    dof = max(1, m - n)
+    s2 = float(fun @ fun) / dof
+    cov = s2 * np.linalg.pinv(jac.T @ jac)
+    var = np.diag(cov).copy()
+    unidentified = var <= 0
+    var[unidentified] = np.inf
+    std = np.sqrt(var)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(std, std)
+    corr[~np.isfinite(corr)] = 0.0
+    np.fill_diagonal(corr, 1.0)
+    return std, np.clip(corr, -1.0, 1.0)

@@ -1,0 +1,140 @@
+"""The fitted parameters: base model (stiffness, friction, tendon zeros) and candidate effects.
+
+Each parameter has fit bounds (what least_squares may explore) and a narrower physical range
+(what this catheter can plausibly have). A fit that ends at a bound or outside the physical
+range is flagged: the model is bending that parameter to hide a missing effect.
+
+Optimisation variables are dimensionless, about one per plausible change:
+    z = ln(value / prior)   for stiffnesses (positive, spanning decades),
+    z = value / scale       for the others.
+Stiffness ranges are relative to the prior catheter (the starting parameters, e.g.
+configs/catheter.toml), since the analysis knows no more about the catheter than that.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from model.effects.catalog import effect
+from model.params import CatheterParams
+
+N_TENDONS = 4
+
+
+@dataclass(frozen=True)
+class FreeParameter:
+    """One fitted scalar: name (units in it), fit bounds, physical range and its optimisation scaling."""
+
+    name: str
+    lower: float
+    upper: float
+    physical: tuple[float, float]
+    log_reference: float | None = None   # z = ln(value / log_reference) when set
+    scale: float = 1.0                    # z = value / scale otherwise
+
+    def to_z(self, value: float) -> float:
+        if self.log_reference is not None:
+            return math.log(value / self.log_reference)
+        return value / self.scale
+
+    def from_z(self, z: float) -> float:
+        if self.log_reference is not None:
+            return self.log_reference * math.exp(z)
+        return z * self.scale
+
+    def flag(self, value: float) -> str | None:
+        """Why the fitted value is suspicious, or None."""
+        span = self.upper - self.lower
+        if value <= self.lower + 1e-3 * span and self.lower < self.physical[0]:
+            return f"{self.name} = {value:.4g} ended at its lower fit bound {self.lower:.4g}"
+        if value >= self.upper - 1e-3 * span:
+            return f"{self.name} = {value:.4g} ended at its upper fit bound {self.upper:.4g}"
+        low, high = self.physical
+        if not low <= value <= high:
+            return f"{self.name} = {value:.4g} left its physical range [{low:.4g}, {high:.4g}]"
+        return None
+
+
+def base_parameters(prior: CatheterParams) -> tuple[FreeParameter, ...]:
+    """Bending and axial stiffness, mu, sigma, Fsc and the four tendon zero offsets.
+
+    Physical ranges: stiffnesses within x/÷10 (EI, sigma) or x/÷100 (EA, whose upper end is
+    'incompressible') of the prior; mu of a tendon in a polymer lumen 0.02-0.6; Fsc up to
+    0.05 N/mm (4 N over 80 mm); a tendon zero within +-1 mm of the drive's zero.
+    """
+    ei, ea, sigma = prior.bending_stiffness_nmm2, prior.axial_stiffness_n, prior.sigma_n_per_mm2
+    fsc_scale = max(prior.fsc_n_per_mm, 0.005)
+    return (
+        FreeParameter("bending_stiffness_nmm2", ei / 1000, ei * 1000, (ei / 10, ei * 10), log_reference=ei),
+        FreeParameter("axial_stiffness_n", ea / 1e4, ea * 1e3, (ea / 100, ea * 100), log_reference=ea),
+        FreeParameter("mu", 0.0, 1.5, (0.02, 0.6), scale=0.1),
+        FreeParameter("sigma_n_per_mm2", sigma / 1000, sigma * 1000, (sigma / 10, sigma * 10), log_reference=sigma),
+        FreeParameter("fsc_n_per_mm", 0.0, 0.2, (0.0, 0.05), scale=fsc_scale),
+    ) + tuple(FreeParameter(f"tendon_zero_{k + 1}_mm", -3.0, 3.0, (-1.0, 1.0), scale=0.1) for k in range(N_TENDONS))
+
+
+N_BASE = 9
+
+
+def effect_parameters(effect_id: str) -> tuple[FreeParameter, ...]:
+    """The candidate's parameters; its catalog range is both fit bound and physical range."""
+    candidate = effect(effect_id)
+    return tuple(FreeParameter(f"{effect_id}.{name}", low, high, (low, high), scale=(high - low) / 10)
+                 for name, low, high in zip(candidate.param_names, candidate.lower, candidate.upper))
+
+
+@dataclass(frozen=True)
+class ParameterLayout:
+    """The vector least_squares sees: the base parameters (if fitted), then each effect's parameters."""
+
+    prior: CatheterParams
+    effect_ids: tuple[str, ...]
+    fit_base: bool = True
+
+    @property
+    def parameters(self) -> tuple[FreeParameter, ...]:
+        base = base_parameters(self.prior) if self.fit_base else ()
+        return base + tuple(p for effect_id in self.effect_ids for p in effect_parameters(effect_id))
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(p.name for p in self.parameters)
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        params = self.parameters
+        return np.array([p.to_z(p.lower) for p in params]), np.array([p.to_z(p.upper) for p in params])
+
+    def values(self, params: CatheterParams, zero_offsets_mm: Sequence[float],
+               effects: Mapping[str, Sequence[float]]) -> np.ndarray:
+        """Physical values in layout order."""
+        base = [params.bending_stiffness_nmm2, params.axial_stiffness_n, params.mu, params.sigma_n_per_mm2,
+                params.fsc_n_per_mm, *zero_offsets_mm] if self.fit_base else []
+        return np.array(base + [float(v) for effect_id in self.effect_ids for v in effects[effect_id]])
+
+    def pack(self, params: CatheterParams, zero_offsets_mm: Sequence[float],
+             effects: Mapping[str, Sequence[float]]) -> np.ndarray:
+        """The optimisation vector z, clipped strictly inside the bounds."""
+        values = self.values(params, zero_offsets_mm, effects)
+        z = np.array([p.to_z(float(np.clip(v, p.lower, p.upper))) for p, v in zip(self.parameters, values)])
+        low, high = self.bounds()
+        inset = 1e-9 * np.maximum(1.0, high - low)
+        return np.clip(z, low + inset, high - inset)
+
+    def unpack(self, z: np.ndarray, params: CatheterParams, zero_offsets_mm: Sequence[float]
+               ) -> tuple[CatheterParams, np.ndarray, dict[str, tuple[float, ...]]]:
+        """(catheter params, zero offsets [4] mm, {effect id: values}) from z; fixed parts from the arguments."""
+        values = [p.from_z(float(v)) for p, v in zip(self.parameters, z)]
+        if self.fit_base:
+            ei, ea, mu, sigma, fsc = values[:5]
+            params = params.replace(bending_stiffness_nmm2=ei, axial_stiffness_n=ea, mu=max(mu, 0.0),
+                                    sigma_n_per_mm2=sigma, fsc_n_per_mm=max(fsc, 0.0))
+            zero_offsets_mm = values[5:N_BASE]
+            values = values[N_BASE:]
+        effects = {}
+        for effect_id in self.effect_ids:
+            n = len(effect(effect_id).param_names)
+            effects[effect_id], values = tuple(values[:n]), values[n:]
+        return params, np.array(zero_offsets_mm, dtype=float), effects

@@ -1,0 +1,80 @@
+"""One experiment as arrays: what the gap analysis works on (it never reads files).
+
+Positions are the MEASURED drive positions (tendon displacement, positive = pulled, and
+free length), because the model is driven by what the drives did, not by what they were told.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+class RecordingError(ValueError):
+    """A recording cannot be analysed (shapes, missing tip samples, inconsistent geometry)."""
+
+
+@dataclass(frozen=True)
+class Recording:
+    """T samples of one experiment (units in the names).
+
+    tendon_mm: [T, 4] measured tendon displacements for tendons at 0, 90, 180, 270 deg.
+    insertion_mm: [T] measured free length out of the support tube.
+    tip_mm: [T, 3] measured tip in the base frame; NaN rows are missing tracker samples.
+    tendon_force_n: [T, 4] measured tendon tension, or None when the log has none.
+    flexible_length_mm, tendon_offset_mm, outer_diameter_mm: the catheter's geometry
+    (outer diameter None when unknown).
+    """
+
+    name: str
+    t_s: np.ndarray
+    tendon_mm: np.ndarray
+    insertion_mm: np.ndarray
+    tip_mm: np.ndarray
+    tendon_force_n: np.ndarray | None
+    flexible_length_mm: float
+    tendon_offset_mm: float
+    outer_diameter_mm: float | None
+
+    def __post_init__(self) -> None:
+        n = len(self.t_s)
+        expected = {"tendon_mm": (n, 4), "insertion_mm": (n,), "tip_mm": (n, 3)}
+        if self.tendon_force_n is not None:
+            expected["tendon_force_n"] = (n, 4)
+        for field, shape in expected.items():
+            if np.shape(getattr(self, field)) != shape:
+                raise RecordingError(f"{self.name}: {field} has shape {np.shape(getattr(self, field))}, "
+                                     f"expected {shape} (t_s has {n} samples)")
+        if n < 3:
+            raise RecordingError(f"{self.name}: {n} samples; a recording needs at least 3")
+        if not np.all(np.diff(self.t_s) > 0):
+            raise RecordingError(f"{self.name}: t_s must increase strictly")
+        if not self.valid.any():
+            raise RecordingError(f"{self.name}: no tip sample is present; the gap needs measured tips")
+
+    def __len__(self) -> int:
+        return len(self.t_s)
+
+    @property
+    def valid(self) -> np.ndarray:
+        """[T] rows with a tip sample."""
+        return np.all(np.isfinite(self.tip_mm), axis=1)
+
+    @property
+    def sample_period_s(self) -> float:
+        """Median time between samples."""
+        return float(np.median(np.diff(self.t_s)))
+
+    def decimated(self, factor: int) -> "Recording":
+        """Every `factor`-th sample (factor 1 returns self).
+
+        The model interpolates the input linearly between kept samples, so decimation is
+        harmless as long as the input path is smooth on the scale of `factor` samples.
+        """
+        if factor <= 1:
+            return self
+        keep = slice(None, None, int(factor))
+        force = None if self.tendon_force_n is None else self.tendon_force_n[keep]
+        return Recording(self.name, self.t_s[keep], self.tendon_mm[keep], self.insertion_mm[keep],
+                         self.tip_mm[keep], force, self.flexible_length_mm, self.tendon_offset_mm,
+                         self.outer_diameter_mm)

@@ -1,0 +1,102 @@
+"""Drive the one Dahl model along recordings: the prediction every fit and comparison uses.
+
+The model input is u_model,k = u_measured,k - zero_k: the tendon zero offsets are where the
+drive's zero lies relative to the tendon's just-taut position. Each recording starts from the
+straight, unloaded state at its first free length.
+"""
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from model.dahl_catheter import DahlCatheter
+from model.effect_terms import EffectTerms
+from model.gap.recording import Recording, RecordingError
+from model.params import CatheterParams
+
+TENDON_RANGE_MARGIN_MM = 10.0
+
+
+@dataclass(frozen=True)
+class Resolution:
+    """How finely the diagnosis simulates: coarser than a plant, fine enough not to change the answer.
+
+    n_elements: lumped elements (the plant uses 20; 8 moves the tip by < 0.05 mm RMS on the
+        standard excitation, well below tracker noise).
+    max_tendon_step_mm, max_insertion_step_mm: quasi-static sub-step sizes (plant: 0.05, 0.5).
+    fit_rate_hz: recordings are decimated to about this rate for fitting and evaluation; the
+        smooth excitation loses nothing at 10 Hz, while the cost of a run scales with the
+        number of samples plus the path length over the sub-step size.
+    """
+
+    n_elements: int = 8
+    max_tendon_step_mm: float = 0.25
+    max_insertion_step_mm: float = 2.0
+    fit_rate_hz: float = 10.0
+
+    def decimation(self, recording: Recording) -> int:
+        """The decimation factor that brings this recording to about `fit_rate_hz`."""
+        return max(1, int(round(1.0 / (recording.sample_period_s * self.fit_rate_hz))))
+
+    def prepare(self, recordings: Sequence[Recording]) -> list[Recording]:
+        return [r.decimated(self.decimation(r)) for r in recordings]
+
+
+def catheter_for(base: CatheterParams, recordings: Sequence[Recording]) -> CatheterParams:
+    """`base` with the geometry of the recordings (which must agree) and ranges that admit their inputs.
+
+    Tendon offset, outer diameter and maximum free length come from the recordings; the free
+    length at reset is set per recording by `predict_tips`.
+    """
+    first = recordings[0]
+    for r in recordings[1:]:
+        if not (np.isclose(r.tendon_offset_mm, first.tendon_offset_mm)
+                and np.isclose(r.flexible_length_mm, first.flexible_length_mm)):
+            raise RecordingError(f"{r.name}: catheter geometry (tendon offset {r.tendon_offset_mm} mm, flexible "
+                                 f"length {r.flexible_length_mm} mm) differs from {first.name} "
+                                 f"({first.tendon_offset_mm} mm, {first.flexible_length_mm} mm); "
+                                 "analyse logs of one catheter together")
+    offset = first.tendon_offset_mm
+    diameter = first.outer_diameter_mm
+    if diameter is None:
+        diameter = max(base.outer_diameter_mm, 2.2 * offset)
+    insertion = np.concatenate([r.insertion_mm for r in recordings])
+    reach = max(float(np.max(np.abs(r.tendon_mm))) for r in recordings) + TENDON_RANGE_MARGIN_MM
+    longest = max(first.flexible_length_mm, float(insertion.max()))
+    shortest = min(base.min_free_length_mm, 0.5 * float(insertion.min()))
+    return base.replace(tendon_offset_mm=offset, outer_diameter_mm=float(diameter), max_free_length_mm=longest,
+                        min_free_length_mm=shortest, free_length_mm=float(np.clip(base.free_length_mm, shortest,
+                                                                                     longest)),
+                        tendon_range_mm=(-reach, reach))
+
+
+def predict_tips(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray, recording: Recording,
+                 resolution: Resolution) -> np.ndarray:
+    """Model tips [T, 3] (mm) along the recording's measured inputs, from the straight state."""
+    model = _model(params, effects, recording, resolution)
+    return model.run(recording.tendon_mm - zero_offsets_mm, recording.insertion_mm, recording.sample_period_s)
+
+
+def predict_tips_and_tension(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray,
+                             recording: Recording, resolution: Resolution) -> tuple[np.ndarray, np.ndarray]:
+    """Model tips [T, 3] (mm) and drive tensions [T, 4] (N), stepping sample by sample (slower)."""
+    model = _model(params, effects, recording, resolution)
+    u = recording.tendon_mm - zero_offsets_mm
+    dt_s = recording.sample_period_s
+    tips = np.empty((len(recording), 3))
+    tension = np.empty((len(recording), 4))
+    for t in range(len(recording)):
+        tips[t] = model.run(u[t:t + 1], recording.insertion_mm[t:t + 1], dt_s)[0]
+        tension[t] = model.drive_tension_n
+    return tips, tension
+
+
+def _model(params: CatheterParams, effects: EffectTerms, recording: Recording,
+           resolution: Resolution) -> DahlCatheter:
+    start = params.replace(free_length_mm=float(np.clip(recording.insertion_mm[0], params.min_free_length_mm,
+                                                        params.max_free_length_mm)))
+    return DahlCatheter(start, n_elements=resolution.n_elements, effects=effects,
+                        max_tendon_step_mm=resolution.max_tendon_step_mm,
+                        max_insertion_step_mm=resolution.max_insertion_step_mm)

@@ -1,0 +1,85 @@
+"""The default plant: the lumped Dahl catheter of `model`, with switchable unmodelled effects."""
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from model import CatheterParams, DahlCatheter, EffectTerms
+from model.effects import combined_terms
+
+DEFAULT_PLANT_TOML = Path(__file__).resolve().parents[2] / "configs" / "virtual_plant.toml"
+
+
+class PlantConfigError(ValueError):
+    """The virtual plant's configuration is invalid; the message names the file and field."""
+
+
+@dataclass(frozen=True)
+class PlantConfig:
+    """What the virtual testbed's catheter is: parameters, mismatch, effects, tracker noise."""
+
+    params: CatheterParams = field(default_factory=CatheterParams)
+    n_elements: int = 20
+    effects: dict = field(default_factory=dict)   # {effect id: {param: value}}
+    tracker_noise_mm: float = 0.05
+    tracker_dropout: float = 0.0
+    tracker_seed: int = 1
+
+    @property
+    def effect_terms(self) -> EffectTerms:
+        return combined_terms(self.effects)
+
+    @classmethod
+    def from_toml(cls, path: str | Path = DEFAULT_PLANT_TOML) -> "PlantConfig":
+        path = Path(path)
+        try:
+            raw = tomllib.loads(path.read_text())
+            params = CatheterParams.from_toml(path.parent / raw.get("catheter", "catheter.toml"))
+            params = params.replace(**{name: getattr(params, name) * _factor(name, factor)
+                                       for name, factor in raw.get("mismatch", {}).items()})
+            tracker = raw.get("tracker", {})
+            config = cls(params=params, n_elements=int(raw.get("n_elements", 20)),
+                         effects={k: dict(v) for k, v in raw.get("effects", {}).items()},
+                         tracker_noise_mm=float(tracker.get("noise_mm", 0.05)),
+                         tracker_dropout=float(tracker.get("dropout", 0.0)),
+                         tracker_seed=int(tracker.get("seed", 1)))
+            config.effect_terms  # validates effect ids, names and ranges
+        except (OSError, tomllib.TOMLDecodeError, ValueError, TypeError, AttributeError) as exc:
+            raise PlantConfigError(f"{path}: {exc}") from exc
+        if not 0.0 <= config.tracker_dropout < 1.0 or config.tracker_noise_mm < 0.0:
+            raise PlantConfigError(f"{path}: [tracker] needs noise_mm >= 0 and 0 <= dropout < 1")
+        return config
+
+    def with_effects(self, effects: dict) -> "PlantConfig":
+        """A copy with these effects switched on in addition ({id: {param: value}})."""
+        merged = dict(self.effects)
+        merged.update(effects)
+        combined_terms(merged)
+        return PlantConfig(self.params, self.n_elements, merged, self.tracker_noise_mm,
+                           self.tracker_dropout, self.tracker_seed)
+
+
+def _factor(name: str, value) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
+        raise ValueError(f"[mismatch].{name} must be a positive factor, got {value!r}")
+    return float(value)
+
+
+class DahlPlant:
+    """`model.DahlCatheter` behind the drives. No-argument construction reads configs/virtual_plant.toml."""
+
+    def __init__(self, config: PlantConfig | None = None):
+        self.config = config if config is not None else PlantConfig.from_toml()
+        self.model = DahlCatheter(self.config.params, self.config.n_elements, self.config.effect_terms)
+
+    def reset(self) -> None:
+        self.model.reset()
+
+    def step(self, dt_s: float, tendon_mm, insertion_mm: float) -> tuple[np.ndarray, np.ndarray]:
+        """Advance to the drives' positions; returns (tip_mm (3,), tendon tension at the drives (4,))."""
+        tendons = np.asarray(tendon_mm, dtype=float).reshape(1, 4)
+        tip = self.model.run(tendons, np.array([float(insertion_mm)]), dt_s=max(float(dt_s), 1e-6))[0]
+        return tip, np.maximum(self.model.drive_tension_n, 0.0)
