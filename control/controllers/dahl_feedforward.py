@@ -31,7 +31,7 @@ class DahlFeedforward(Controller):
     name = "dahl"
 
     def __init__(self, workspace: Workspace, limits: MotionLimits = MotionLimits(), period_s: float = 0.01, *,
-                 n_elements: int = 20, insertion_weight: float = 1e-3, tolerance_mm: float = 0.01):
+                 n_elements: int = 20, insertion_weight: float = 1e-3, tolerance_mm: float = 0.03):
         self.workspace = workspace
         self.model = DahlCatheter(workspace.params, n_elements)
         self.inverse = DahlInverse(self.model, workspace.pretension_mm, insertion_weight=insertion_weight,

@@ -24,6 +24,10 @@ def check_samples(t_s: np.ndarray, bend_rad: np.ndarray, insertion_mm: np.ndarra
     if len(t_s) == 0:
         raise TrajectoryError("the trajectory is empty: give it a non-zero distance or duration")
 
+    problem = workspace.violation(start)
+    if problem is not None:
+        raise TrajectoryError(f"the start {start} is outside the workspace: {problem}")
+
     def where(k: int) -> str:
         return f"at t={t_s[k]:.3f} s ({labels[k]})"
 

@@ -139,7 +139,7 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
     z0 = layout.pack(start, zero_start, effects)
     low, high = layout.bounds()
     result = least_squares(residuals, z0, bounds=(low, high), method="trf", diff_step=DIFF_STEP,
-                           ftol=TOLERANCE, xtol=TOLERANCE, gtol=1e-8, max_nfev=max_iterations, verbose=2)
+                           ftol=TOLERANCE, xtol=TOLERANCE, gtol=1e-8, max_nfev=max_iterations)
     params, zero, values = layout.unpack(result.x, start, zero_start)
     std_z, correlation = _statistics(result.jac, result.fun, len(result.x))
     physical = np.array([p.from_z(z) for p, z in zip(layout.parameters, result.x)])

@@ -46,11 +46,12 @@ class FreeParameter:
         return z * self.scale
 
     def flag(self, value: float) -> str | None:
-        """Why the fitted value is suspicious, or None."""
-        span = self.upper - self.lower
-        if value <= self.lower + 1e-3 * span and self.lower < self.physical[0]:
+        """Why the fitted value is suspicious, or None (a bound counts when within 0.1 % of the z range)."""
+        z, z_low, z_high = self.to_z(value), self.to_z(self.lower), self.to_z(self.upper)
+        near = 1e-3 * (z_high - z_low)
+        if z <= z_low + near and self.lower < self.physical[0]:
             return f"{self.name} = {value:.4g} ended at its lower fit bound {self.lower:.4g}"
-        if value >= self.upper - 1e-3 * span:
+        if z >= z_high - near:
             return f"{self.name} = {value:.4g} ended at its upper fit bound {self.upper:.4g}"
         low, high = self.physical
         if not low <= value <= high:

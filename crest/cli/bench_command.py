@@ -1,0 +1,61 @@
+"""`crest bench --json OUT.json`: measure the stack against its limits, on this machine."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from crest.bench import model_bench
+from crest.bench.machine_info import machine_info
+from model import CatheterParams
+
+SECTIONS = ("model", "scaling", "move", "controllers", "full_stack", "gap")
+
+
+def add_parser(sub) -> None:
+    parser = sub.add_parser("bench", help="benchmark the model, controllers, full stack and gap diagnosis")
+    parser.add_argument("--json", dest="json_path", default="bench.json", help="where to write the results")
+    parser.add_argument("--only", nargs="+", choices=SECTIONS, default=list(SECTIONS),
+                        help="run only these sections")
+    parser.add_argument("--stack-seconds", type=float, default=60.0,
+                        help="duration of the full-stack run at 500 Hz SYNC (default 60)")
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    params = CatheterParams.from_toml()
+    results: dict = {"machine": machine_info()}
+    steps = {
+        "model": lambda: model_bench.model_step(params),
+        "scaling": lambda: model_bench.scaling_in_n(params),
+        "move": lambda: model_bench.quasi_static_move(params),
+    }
+    for name in args.only:
+        if name not in steps:
+            continue
+        print(f"crest bench: {name} ...", file=sys.stderr, flush=True)
+        results[name] = steps[name]()
+    path = Path(args.json_path)
+    path.write_text(json.dumps(results, indent=2))
+    print(format_table(results))
+    print(f"results written to {path}")
+    return 0
+
+
+def format_table(results: dict) -> str:
+    rows = []
+    if "model" in results:
+        r = results["model"]
+        rows.append(("Model step, N=20", f"{r['step_rate_hz']:.0f} steps/s, {r['real_time_factor']:.0f}x real time",
+                     f">= {r['goal_real_time_factor']:.0f}x", r["real_time_factor"] >= r["goal_real_time_factor"]))
+    if "scaling" in results:
+        r = results["scaling"]
+        rows.append(("Cost exponent in N (10..320)", f"{r['cost_exponent']:.2f}", f"<= {r['goal_cost_exponent']}",
+                     r["cost_exponent"] <= r["goal_cost_exponent"]))
+    if "move" in results:
+        rows.append(("move_to 0 -> 180 deg", f"{results['move']['wall_ms']:.1f} ms", "-", None))
+    lines = ["| measure | result | goal | met |", "|---|---|---|---|"]
+    for name, value, goal, met in rows:
+        lines.append(f"| {name} | {value} | {goal} | {'-' if met is None else ('yes' if met else 'NO')} |")
+    return "\n".join(lines)

@@ -1,0 +1,146 @@
+"""Candidate effects: fit each on the training recordings, evaluate on held-out, rank them.
+
+Every candidate is fitted the same way, whatever it is: its 1-3 parameters jointly with the
+base parameters, warm-started from the baseline calibration, on the training recordings;
+then its held-out tip RMSE is compared with the baseline's. The fits are independent and run
+in parallel processes.
+
+Ranking score (higher is better):
+
+    score = shrink - PARAMETER_PENALTY * n_params + SIGNATURE_WEIGHT * match
+
+shrink = 1 - RMSE_after / RMSE_before on held-out data; match = cosine between the
+candidate's correction c = tip_candidate - tip_baseline and the baseline's residual
+-e = tip_measured - tip_baseline over all held-out samples (1: the candidate moves the tip
+exactly the way the residual points; 0: unrelated). A candidate is meaningful only if it
+removes more than the noise can explain (`is_meaningful`).
+"""
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+
+import numpy as np
+
+from model.effects.catalog import effect
+from model.gap.calibration import ModelFit, calibrate, rmse_mm, tip_errors
+from model.gap.recording import Recording
+from model.gap.simulation import Resolution
+from model.params import CatheterParams
+
+PARAMETER_PENALTY = 0.005   # shrink charged per added parameter
+SIGNATURE_WEIGHT = 0.02     # score bonus for a correction that points where the residual does
+MIN_SHRINK = 0.03           # a meaningful effect removes at least 3 % of the held-out RMSE ...
+MIN_SHRINK_WITHOUT_NOISE = 0.05   # ... or 5 % when the noise floor is unknown
+MIN_GAIN_OVER_NOISE = 0.1   # ... and at least 10 % of the noise variance 3 sigma^2 (mm^2)
+CANDIDATE_ITERATIONS = 15
+
+
+@dataclass(frozen=True)
+class CandidateResult:
+    """One fitted effect set: fit, held-out RMSE and held-out errors, shrink, match and score."""
+
+    effects: tuple[str, ...]
+    fit: ModelFit
+    holdout_rmse_mm: float
+    holdout_errors: tuple[np.ndarray, ...]
+    shrink: float
+    signature_match: float
+    score: float
+
+    @property
+    def n_params(self) -> int:
+        return sum(len(effect(effect_id).param_names) for effect_id in self.effects)
+
+    def as_dict(self) -> dict:
+        return {"effect": "+".join(self.effects) if self.effects else "none", "effects": list(self.effects),
+                "params": self.fit.effect_params() if len(self.effects) > 1
+                else self.fit.effect_params().get(self.effects[0], {}) if self.effects else {},
+                "n_params": self.n_params, "train_rmse_mm": self.fit.train_rmse_mm,
+                "holdout_rmse_mm": self.holdout_rmse_mm, "shrink": self.shrink,
+                "signature_match": self.signature_match, "score": self.score, "flags": list(self.fit.flags)}
+
+
+def start_values(effect_id: str) -> tuple[float, ...]:
+    """Where a candidate's fit starts: off (0) where 0 is in range, else its typical value."""
+    candidate = effect(effect_id)
+    return tuple(0.0 if low <= 0.0 <= high else typ
+                 for typ, low, high in zip(candidate.typical, candidate.lower, candidate.upper))
+
+
+@dataclass(frozen=True)
+class FitTask:
+    """Everything one worker needs to fit and evaluate one effect set (picklable)."""
+
+    effects: dict[str, tuple[float, ...]]
+    start: ModelFit
+    prior: CatheterParams
+    train: tuple[Recording, ...]
+    holdout: tuple[Recording, ...]     # already at the fit resolution
+    baseline_errors: tuple[np.ndarray, ...]
+    baseline_rmse_mm: float
+    resolution: Resolution
+    iterations: int = CANDIDATE_ITERATIONS
+
+
+def run_task(task: FitTask) -> CandidateResult:
+    """Fit the task's effects with the base parameters and evaluate them on the held-out data."""
+    fit = calibrate(task.train, task.start.params, prior=task.prior, zero_offsets_mm=task.start.zero_offsets_mm,
+                    effects=task.effects, resolution=task.resolution, max_iterations=task.iterations)
+    errors = tuple(tip_errors(fit, task.holdout, task.resolution))
+    return evaluate(tuple(task.effects), fit, errors, task.baseline_errors, task.baseline_rmse_mm)
+
+
+def evaluate(effects: tuple[str, ...], fit: ModelFit, errors: Sequence[np.ndarray],
+             baseline_errors: Sequence[np.ndarray], baseline_rmse_mm: float) -> CandidateResult:
+    """Held-out RMSE, shrink, signature match and score of a fitted effect set."""
+    holdout_rmse = rmse_mm(errors)
+    shrink = 1.0 - holdout_rmse / baseline_rmse_mm if baseline_rmse_mm > 0 else 0.0
+    e = np.concatenate(baseline_errors).ravel()
+    c = np.concatenate(errors).ravel() - e
+    norm = np.linalg.norm(c) * np.linalg.norm(e)
+    match = float(-(c @ e) / norm) if norm > 0 else 0.0
+    n_params = sum(len(effect(effect_id).param_names) for effect_id in effects)
+    score = shrink - PARAMETER_PENALTY * n_params + SIGNATURE_WEIGHT * match
+    return CandidateResult(effects, fit, holdout_rmse, tuple(errors), shrink, match, score)
+
+
+def run_tasks(tasks: Sequence[FitTask], workers: int = 2,
+              on_done: Callable[[CandidateResult], None] | None = None) -> list[CandidateResult]:
+    """Run the fits in `workers` processes (in this process when workers <= 1); results in task order."""
+    if workers <= 1 or len(tasks) <= 1:
+        results = []
+        for task in tasks:
+            results.append(run_task(task))
+            if on_done is not None:
+                on_done(results[-1])
+        return results
+    results: list[CandidateResult | None] = [None] * len(tasks)
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        futures = {pool.submit(run_task, task): index for index, task in enumerate(tasks)}
+        for future in as_completed(futures):
+            results[futures[future]] = future.result()
+            if on_done is not None:
+                on_done(results[futures[future]])
+    return results
+
+
+def is_meaningful(rmse_before_mm: float, rmse_after_mm: float, noise_mm: float | None) -> bool:
+    """Does going from before to after remove more error than noise and fitting freedom explain?
+
+    With a noise floor sigma (per axis): shrink >= MIN_SHRINK and
+    before^2 - after^2 >= MIN_GAIN_OVER_NOISE * 3 sigma^2; without: shrink >= MIN_SHRINK_WITHOUT_NOISE.
+    """
+    if rmse_before_mm <= 0:
+        return False
+    shrink = 1.0 - rmse_after_mm / rmse_before_mm
+    if noise_mm is None:
+        return shrink >= MIN_SHRINK_WITHOUT_NOISE
+    gain = rmse_before_mm ** 2 - rmse_after_mm ** 2
+    return shrink >= MIN_SHRINK and gain >= MIN_GAIN_OVER_NOISE * 3.0 * noise_mm ** 2
+
+
+def ranked(results: Sequence[CandidateResult]) -> list[CandidateResult]:
+    """Best score first."""
+    return sorted(results, key=lambda result: -result.score)
