@@ -21,6 +21,8 @@ The free length is an unknown because a catheter whose curvature is not constant
 consumes tension toward the tip) cannot put its tip on an arbitrary point at a fixed length:
 at 180 deg the pulls alone leave ~3 mm. The small w_L only keeps L near the set-point where
 the pulls suffice. The model's state is restored after every trial: solving commits nothing.
+A call costs at most max_evaluations model moves; it stops early at the tolerance, or when an
+accepted step lowers J by less than MIN_PROGRESS.
 """
 from __future__ import annotations
 
@@ -31,6 +33,8 @@ import numpy as np
 from model import DahlCatheter
 
 from control.inverse_kinematics import tendons_from_pulls
+
+MIN_PROGRESS = 0.01   # an accepted step must lower J by this fraction, or the solve stops
 
 
 @dataclass(frozen=True)
@@ -91,9 +95,12 @@ class DahlInverse:
             jacobian = jacobian + np.outer(trial_tip - tip - jacobian @ step, step) / (step @ step)
             trial_cost = self._cost(target, trial_tip, trial, x_ref)
             if trial_cost < cost:
+                stalled = trial_cost > (1.0 - MIN_PROGRESS) * cost
                 x, tip, cost, fresh = trial, trial_tip, trial_cost, False
                 damping = max(damping / 3.0, self.damping)
-            elif not fresh:
+                if stalled:
+                    break   # held by a bound or a kink of the friction law: more trials buy nothing
+            elif not fresh and evaluations + 3 <= self.max_evaluations:
                 jacobian = self._finite_differences(start, x, tip, upper)
                 evaluations += 3
                 fresh = True

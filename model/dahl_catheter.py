@@ -23,6 +23,10 @@ class ModelInputError(ValueError):
     """A command given to the model is not finite or outside its configured range."""
 
 
+class ModelSolverError(ArithmeticError):
+    """The equilibrium solve produced a non-finite state (parameters far outside their range)."""
+
+
 @dataclass
 class CatheterState:
     """Everything that evolves: applied inputs, friction state, tensions and shape."""
@@ -138,12 +142,17 @@ class DahlCatheter:
         return self._run(tendons, insertion, float(dt_s))
 
     def _run(self, tendons: np.ndarray, insertion: np.ndarray, dt_s: float) -> np.ndarray:
+        before = self.state.copy()
         s = self.state
         tips = np.empty((len(tendons), 3))
         run_path(tendons, insertion, dt_s, self.max_tendon_step_mm, self.max_insertion_step_mm,
                  self._kernel_params, self._kernel_effects, s.applied_tendon_mm, s.applied_insertion_mm,
                  s.friction_n, s.sliding_mm, s.last_step_mm, s.tension_n, s.bend_rad, s.compression_mm,
                  s.tip_tension_n, s.drive_tension_n, s.slack, s.points_mm, s.frames, s.diagnostics, tips)
+        if not (np.isfinite(tips).all() and np.isfinite(s.friction_n).all()):
+            self.state = before
+            raise ModelSolverError(f"the catheter model diverged (non-finite state) with {self.params}; "
+                                   "the state is unchanged. Check the parameters' ranges.")
         return tips + self._tracker_offset_mm
 
     def _validated(self, tendons: np.ndarray, insertion: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -24,9 +24,11 @@ itself stretches by (h/EA_t) T_ki. Compatibility of an inextensible, taut tendon
 
     sum_i [delta_ki + (h/EA_t) T_ki] + c_drive * T_k^drive = u_k         (T_k^tip >= 0)
 
-and a tendon that would need to push is slack (zero tension). Sliding of tendon k past
-element i (toward the base) is x_ki = sum_{j>i} delta'_kj + delta'_ki/2, with delta' the
-shortening plus stretch, and the Dahl force follows paper eq. 1 with Fs from eq. 3.
+and a tendon that would need to push is slack (zero tension). Sliding of tendon k past the
+centre of element i (toward the base) is x_ki = sum_{j>i} delta'_kj + delta'_ki(P)/2, with
+delta' the shortening plus stretch and P the tension of the element's distal half (the
+friction force acts at the centre, so it loads only the proximal half). The Dahl force
+follows paper eq. 1 with Fs from eq. 3.
 
 Implicit solution. Everything at element i is affine in the four tip tensions, because the
 friction increment is linearised, F_ki = F_ki^0 + k_ki (x_ki - x_ki^0) + g_ki (T_ki - T_ki^0). One sweep from
@@ -66,6 +68,7 @@ S_UNCONVERGED = 1   # steps that hit the iteration limit
 N_SCALARS = 2
 
 MAX_NEWTON_ITERATIONS = 12
+MAX_HALVINGS = 10   # an unconverged sub-step is retried in halves, down to 1/1024 of it
 FORCE_TOLERANCE_N = 1e-4  # exact vs linearised Dahl force per element; 1e-4 N moves the tip < 1 um
 
 
@@ -147,9 +150,11 @@ def _sweep(n, h, params, arm, cos_phi, sin_phi, ext_bend, f0, kx, gt, gth, bend_
     distal sums of force and shortening over the whole catheter (dist_force, dist_short).
 
     Friction is linearised about the last iterate (x_ref, T_ref, F0):
-        F = F0 + K (x - x_ref) + G (T - T_ref),   T = P + F/2,   x = S + (D T + d0)/2
-    with P = T_tip + C_dist and S = S_dist the distal sums, which gives per element
-        (I - K D/4 - G/2) F = F0 + K (S + D P/2 + d0/2 - x_ref) + G (P - T_ref).
+        F = F0 + K (x - x_ref) + G (T - T_ref),   T = P + F/2,   x = S + (D P + d0)/2
+    with P = T_tip + C_dist the tension of the element's distal half and S = S_dist the distal
+    shortening: the sliding at the element's centre comes from the distal half only, which
+    carries P, not F. That gives per element
+        (I - G/2) F = F0 + K (S + D P/2 + d0/2 - x_ref) + G (P - T_ref).
     K = diag(dF/dx). G_km = dF_k/dT_m holds the capstan dependence of Fs on the tendon's own
     tension, gt_k (k = m), and on the element angle theta, which every tension bends:
     gth_k * dtheta/dT_m with dtheta/dT_m = (r/K_b) (u . e_m), u the unit bend direction.
@@ -194,8 +199,8 @@ def _sweep(n, h, params, arm, cos_phi, sin_phi, ext_bend, f0, kx, gt, gth, bend_
             hk = gth[k, i]
             # G_km = gt_k delta_km + gth_k w_m;  D_km = ka + c e_k.e_m + kt delta_km
             for m in range(4):
-                a[k, m] = -0.25 * kk * (ka + c * (e0[k] * e0[m] + e1[k] * e1[m])) - 0.5 * hk * w[m]
-            a[k, k] += 1.0 - 0.25 * kk * kt - 0.5 * gk
+                a[k, m] = -0.5 * hk * w[m]
+            a[k, k] += 1.0 - 0.5 * gk
             w_tref = w[0] * tref[0, i] + w[1] * tref[1, i] + w[2] * tref[2, i] + w[3] * tref[3, i]
             for col in range(5):
                 rhs[k, col] = kk * (dist_short[k, col] + 0.5 * dp[k, col]) + gk * pull[k, col] + hk * w_pull[col]
@@ -338,17 +343,21 @@ def make_workspace(n):
             np.empty((4, n)), np.empty((4, n)), np.empty((n, 4, 5)), np.empty(4), np.empty(4),
             np.empty((4, 5)), np.empty((4, 5)), np.empty((4, n)), np.empty((4, n)),
             np.empty((4, n)), np.empty((n, 2)), np.empty(n), np.empty((4, n)), np.empty(4),
-            np.zeros(4, dtype=np.bool_), np.empty(n))
+            np.zeros(4, dtype=np.bool_), np.empty(n), np.zeros((4, n), dtype=np.bool_), np.empty(4),
+            np.zeros((4, n), dtype=np.bool_))
 
 
 @kernel
 def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_step, tension,
-                      bend, compression, tip_tension, drive_tension, slack, points, frames, scalars, work):
+                      bend, compression, tip_tension, drive_tension, slack, points, frames, scalars, work,
+                      commit_unconverged):
     """Advance the catheter state to equilibrium at tendon input u [mm] and free length [mm].
 
     `dt_s` is the time the step takes (inf for a purely quasi-static move); it only enters
-    the rate-dependent friction term. All state arrays are updated in place; `work` is
-    scratch space from make_workspace.
+    the rate-dependent friction term. `work` is scratch space from make_workspace. Returns
+    True when Newton converged; the state arrays are then updated in place. An unconverged
+    step leaves the state untouched (the caller retries with a smaller step) unless
+    `commit_unconverged`.
     """
     n = bend.shape[0]
     h = length / n
@@ -362,7 +371,8 @@ def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_
 
     (arm, angle, rest_bend, ext_bend, cos_phi, sin_phi, f0, kx, gt, gth, bend_dir, xref, tref, lin_force,
      distal_force, distal_short, dist_force, dist_short, new_force, new_sliding, new_tension,
-     new_bend, new_compression, increment, linear_force, revived, lengths) = work
+     new_bend, new_compression, increment, linear_force, revived, lengths, clamped, previous_increment,
+     crossed) = work
     _element_modifiers(n, length, params, effects, tension, bend, points, frames,
                        arm, angle, rest_bend, ext_bend)
     for i in range(n):  # tendon k at phi_k = k*90 deg + twist offset
@@ -383,6 +393,9 @@ def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_
 
     increment[:, :] = 0.0
     revived[:] = False
+    clamped[:, :] = False
+    crossed[:, :] = False
+    slack_before = slack.copy()
     converged = False
     for iteration in range(MAX_NEWTON_ITERATIONS):
         scalars[S_ITERATIONS] += 1.0
@@ -404,12 +417,19 @@ def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_
             total = 0.0
             along0 = 0.0
             along1 = 0.0
+            distal_total = 0.0
+            distal_along0 = 0.0
+            distal_along1 = 0.0
             for k in range(4):
                 linear = lin_force[i, k, 0]
                 for m in range(4):
                     linear += lin_force[i, k, m + 1] * tip_tension[m]
                 linear_force[k] = linear
-                t = tip_tension[k] + distal_force[k] + 0.5 * linear
+                distal = tip_tension[k] + distal_force[k]
+                distal_total += distal
+                distal_along0 += distal * cos_phi[i, k]
+                distal_along1 += distal * sin_phi[i, k]
+                t = distal + 0.5 * linear
                 new_tension[k, i] = t
                 total += t
                 along0 += t * cos_phi[i, k]
@@ -420,17 +440,41 @@ def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_
             new_bend[i, 1] = by
             new_compression[i] = ka * total
             for k in range(4):
-                # delta = D T + d0 with D = ka*J + (r^2/K_b) E E^T + kt*I
+                # delta = D T + d0 with D = ka*J + (r^2/K_b) E E^T + kt*I, for the mean tension T
+                # (whole element) and for the distal half's tension P (sliding at the centre)
+                external = r * (ext_bend[i, 0] * cos_phi[i, k] + ext_bend[i, 1] * sin_phi[i, k])
                 shortening = (ka * total + c * (cos_phi[i, k] * along0 + sin_phi[i, k] * along1)
-                              + kt * new_tension[k, i]
-                              + r * (ext_bend[i, 0] * cos_phi[i, k] + ext_bend[i, 1] * sin_phi[i, k]))
-                new_sliding[k, i] = distal_short[k] + 0.5 * shortening
+                              + kt * new_tension[k, i] + external)
+                distal_half = (ka * distal_total + c * (cos_phi[i, k] * distal_along0 + sin_phi[i, k] * distal_along1)
+                               + kt * (tip_tension[k] + distal_force[k]) + external)
+                new_sliding[k, i] = distal_short[k] + 0.5 * distal_half
                 distal_short[k] += shortening
                 distal_force[k] += linear_force[k]
                 increment[k, i] = new_sliding[k, i] - sliding[k, i]
+            for k in range(4):
+                previous_increment[k] = xref[k, i] - sliding[k, i]
             _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_per_step, friction, increment,
                                new_tension, slack, f0, kx, gt, gth, bend_dir)
             for k in range(4):
+                # Dahl has a kink at zero sliding (one-sided slopes differ up to 2 sigma). Where the
+                # iterate crossed it (once in this step), the chord from the step's start replaces
+                # the tangent, so Newton cannot jump back and forth across the kink.
+                if increment[k, i] * previous_increment[k] < 0.0:
+                    crossed[k, i] = True
+                if crossed[k, i] and increment[k, i] != 0.0:
+                    kx[k, i] = max((f0[k, i] - friction[k, i]) / increment[k, i], 0.0)
+                # A tendon cannot be pushed: friction may at most unload the proximal half to zero,
+                # F >= -max(P, 0). Clamped at F = -P > 0 it is linear in the tension: K = 0, G = -2
+                # (T = P + F/2); at F = 0 (P <= 0) it is constant. Once clamped, an element stays
+                # clamped for the step, so Newton cannot cycle on the kink.
+                distal_tension = tip_tension[k] + distal_force[k] - linear_force[k]
+                floor = -max(distal_tension, 0.0)
+                if not slack[k] and (f0[k, i] < floor or clamped[k, i]):
+                    clamped[k, i] = True
+                    f0[k, i] = floor
+                    kx[k, i] = 0.0
+                    gt[k, i] = -2.0 if distal_tension > 0.0 else 0.0
+                    gth[k, i] = 0.0
                 new_force[k, i] = f0[k, i]
                 worst = max(worst, abs(f0[k, i] - linear_force[k]))
                 xref[k, i] = new_sliding[k, i]
@@ -439,6 +483,9 @@ def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_
             converged = True
             break
     if not converged:
+        if not commit_unconverged:
+            slack[:] = slack_before
+            return False
         scalars[S_UNCONVERGED] += 1.0
 
     for k in range(4):
@@ -456,6 +503,7 @@ def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_
         compression[i] = new_compression[i]
         lengths[i] = h - new_compression[i]
     compose_backbone(bend, lengths, points, frames)
+    return True
 
 
 @kernel
@@ -528,16 +576,26 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
         start_length = applied_insertion_mm[0]
         start = applied_tendon_mm.copy()
         length = start_length
-        for j in range(1, n_sub + 1):
-            w = j / n_sub
+        # Advance through the fraction w of the sample; a sub-step whose Newton solve does not
+        # converge (a sharp friction reversal) is halved, down to 1/2^MAX_HALVINGS of a sub-step.
+        done = 0.0
+        fraction = 1.0 / n_sub
+        smallest = fraction / 2.0 ** MAX_HALVINGS
+        while done < 1.0 - 1e-12:
+            fraction = min(fraction, 1.0 - done)
+            w = done + fraction
             for k in range(4):
                 u[k] = start[k] + w * (target[k] - start[k])
             previous_length = length
             length = start_length + w * (length_target - start_length)
             remap_to_length(previous_length, length, friction, sliding, last_step, tension)
-            quasi_static_step(u, length, dt_s / n_sub, params, effects, friction, sliding, last_step,
-                              tension, bend, compression, tip_tension, drive_tension, slack, points,
-                              frames, scalars, work)
+            if quasi_static_step(u, length, dt_s * fraction, params, effects, friction, sliding, last_step,
+                                 tension, bend, compression, tip_tension, drive_tension, slack, points,
+                                 frames, scalars, work, fraction <= smallest):
+                done = w
+                fraction = min(2.0 * fraction, 1.0 / n_sub)
+            else:
+                fraction *= 0.5
         for k in range(4):
             applied_tendon_mm[k] = target[k]
         applied_insertion_mm[0] = length_target

@@ -9,20 +9,26 @@ sees every frame, the drives' included.
 
 ``tick(now_s)`` (s since the testbed started) drives the drives' time-based
 duties and fires scheduled per-axis faults; SYNC frames from the client drive
-their motion.
+their motion. SYNC listeners run after every drive has handled a SYNC, in the
+same thread, so a plant stepped there is coupled cycle by cycle: its output
+(``set_load_tension_n``) goes out in the TPDOs of the next SYNC.
 """
 
 from __future__ import annotations
 
-from typing import Iterable, Sequence
+from typing import Callable, Iterable, Sequence
 
 import can
 import canopen
 
 from sim_backend.bus_load import BusLoadMeter, BusLoadReport
 from sim_backend.drive.drive_spec import DriveSpec
-from sim_backend.drive.sim_drive import SimDrive
+from sim_backend.drive.sim_drive import SYNC_COB_ID, SimDrive
 from sim_backend.faults import FaultSchedule, FaultSpec
+
+
+#: Receive poll period of the notifier threads (s): how long ``stop`` may wait for them.
+NOTIFIER_POLL_S = 0.05
 
 
 class SimDriveSet:
@@ -43,6 +49,8 @@ class SimDriveSet:
                 raise ValueError(f"fault {fault}: no drive named {fault.axis!r}; "
                                  f"drives are {', '.join(self.drives)}")
         self._schedule = FaultSchedule(drive_faults)
+        self.sync_period_s = sync_period_s
+        self._sync_listeners: list[Callable[[int, bytearray, float], None]] = []
         self.bus_load = BusLoadMeter(bitrate_bit_s, sync_period_s)
         self._network: canopen.Network | None = None
         self._meter_bus: can.BusABC | None = None
@@ -54,14 +62,25 @@ class SimDriveSet:
         except KeyError:
             raise KeyError(f"no drive named {name!r}; drives are {', '.join(self.drives)}") from None
 
+    def add_sync_listener(self, listener: Callable[[int, bytearray, float], None]) -> None:
+        """Call ``listener(can_id, data, timestamp)`` (canopen's subscriber signature) for each
+        SYNC frame, after every drive has run its cycle for it."""
+        self._sync_listeners.append(listener)
+
+    def _on_sync(self, can_id: int, data: bytearray, timestamp: float) -> None:
+        for listener in self._sync_listeners:
+            listener(can_id, data, timestamp)
+
     def start(self) -> None:
         """Open the bus, attach the drives and power them on (each sends its boot-up message)."""
         self._meter_bus = can.Bus(interface="virtual", channel=self.channel)
-        self._meter_notifier = can.Notifier(self._meter_bus, [self.bus_load])
+        self._meter_notifier = can.Notifier(self._meter_bus, [self.bus_load], timeout=NOTIFIER_POLL_S)
         self._network = canopen.Network(can.Bus(interface="virtual", channel=self.channel))
+        self._network.NOTIFIER_CYCLE = NOTIFIER_POLL_S
         self._network.connect()
         for drive in self.drives.values():
             drive.attach(self._network)
+        self._network.subscribe(SYNC_COB_ID, self._on_sync)  # after the drives' own SYNC handlers
         for drive in self.drives.values():
             drive.power_on()
 

@@ -35,10 +35,6 @@ class FaultKind(enum.Enum):
     CRC = "crc"
     MISSING_TOOL = "missing_tool"
 
-    @property
-    def is_tracker_fault(self) -> bool:
-        return self in TRACKER_FAULT_KINDS
-
 
 DRIVE_FAULT_KINDS = frozenset({FaultKind.EMCY, FaultKind.HEARTBEAT, FaultKind.STALL,
                                FaultKind.SDO_TIMEOUT, FaultKind.ERROR_FRAMES})

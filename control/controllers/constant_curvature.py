@@ -25,8 +25,8 @@ class ConstantCurvatureController(Controller):
         self.workspace = workspace
         self.limiter = CommandLimiter(workspace, limits, period_s)
 
-    def reset(self) -> None:
-        self.limiter.reset()
+    def reset(self, insertion_mm: float | None = None) -> None:
+        self.limiter.reset(insertion_mm=insertion_mm)
 
     def command(self, setpoint: SetPoint, tip: TipMeasurement | None = None,
                 drive_tension_n: np.ndarray | None = None) -> TendonCommand:

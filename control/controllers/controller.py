@@ -19,7 +19,8 @@ class Controller(ABC):
     command(setpoint, tip, drive_tension_n): `tip` is the latest tracker sample (None when
     there is none this cycle), `drive_tension_n` the (4,) tendon tensions from the drives
     when available. Open-loop controllers ignore both. Returns the TendonCommand to send.
-    reset(): forget all history; the catheter is straight, unloaded, at the home free length.
+    reset(insertion_mm): forget all history; the catheter is straight and unloaded, tendons at
+    0 mm, at this free length (default: the workspace's home free length).
     """
 
     name: str
@@ -30,7 +31,7 @@ class Controller(ABC):
         ...
 
     @abstractmethod
-    def reset(self) -> None:
+    def reset(self, insertion_mm: float | None = None) -> None:
         ...
 
 

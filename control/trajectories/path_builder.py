@@ -65,6 +65,9 @@ class PathBuilder:
         require_positive(bend_velocity_rad_s=bend_velocity_rad_s, bend_acceleration_rad_s2=bend_acceleration_rad_s2)
         require_finite(target_bend_x_rad=float(to_bend[0]), target_bend_y_rad=float(to_bend[1]),
                        target_insertion_mm=to_insertion_mm)
+        problem = self.workspace.violation(Articulation.from_bend(to_bend, to_insertion_mm))
+        if problem is not None:
+            raise TrajectoryError(f"the target of segment '{label}' is outside the workspace: {problem}")
         d_bend = to_bend - self.bend_rad
         d_length = float(to_insertion_mm) - self.insertion_mm
         velocity, acceleration = math.inf, math.inf

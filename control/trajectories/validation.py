@@ -4,7 +4,8 @@ The trajectory is checked as the constant-curvature commands it implies: tendons
 u_k = r theta cos(phi_k - plane) + u0 and the free length L, preceded by the start held at
 rest. With period T, velocity (x_k - x_k-1)/T and acceleration (x_k - 2 x_k-1 + x_k-2)/T^2
 of every tendon and of L must stay within the configured limits (a relative slack of 1e-6
-absorbs rounding). The message names the sample time, segment, axis and what to change.
+absorbs rounding). The message names the axis, the peak value, where it first
+exceeds the limit (time and segment) and what to change.
 """
 from __future__ import annotations
 
@@ -57,7 +58,6 @@ def check_samples(t_s: np.ndarray, bend_rad: np.ndarray, insertion_mm: np.ndarra
                                                                                  "acceleration", "mm/s^2")):
             over = np.flatnonzero(value > limit * (1.0 + RELATIVE_SLACK))
             if over.size:
-                k = int(over[0])
-                raise TrajectoryError(f"{name} {what} {value[k]:.1f} {unit} {where(k)} exceeds the configured "
-                                      f"maximum {limit} {unit}: slow the trajectory down (lower its velocity or "
-                                      f"acceleration, or lengthen its period)")
+                raise TrajectoryError(f"{name} {what} {value.max():.1f} {unit} exceeds the configured maximum "
+                                      f"{limit} {unit} (first {where(int(over[0]))}): slow the trajectory down "
+                                      f"(lower its velocity or acceleration, or lengthen its period)")

@@ -7,11 +7,12 @@ from __future__ import annotations
 import argparse
 import sys
 
-from crest.cli import bench_command, demo_command
+from crest.cli import bench_command, demo_command, paper_command
 from crest.exit_codes import ExitCode
 
 COMMANDS = {
     "demo": demo_command,
+    "paper": paper_command,
     "bench": bench_command,
 }
 

@@ -32,6 +32,13 @@ from model.params import CatheterParams
 
 DIFF_STEP = 0.02       # relative finite-difference step: far above the kernel's ~1 um solver noise
 TOLERANCE = 1e-4       # relative change of cost / parameters at which the fit stops
+# The friction history makes the cost jump where a parameter change flips a tendon between slack
+# and taut at some moment; the trust region then collapses (xtol). A fresh start from the point
+# reached usually continues: restart while a run still lowers the cost by RESTART_GAIN.
+MAX_RESTARTS = 2
+RESTART_GAIN = 0.01
+XTOL_REACHED = 3       # least_squares status
+DIVERGED_RESIDUAL_MM = 1e3
 
 
 @dataclass(frozen=True)
@@ -109,10 +116,12 @@ def tip_errors(fit: ModelFit, recordings: Sequence[Recording], resolution: Resol
 def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: CatheterParams | None = None,
               zero_offsets_mm: Sequence[float] = (0.0, 0.0, 0.0, 0.0),
               effects: Mapping[str, Sequence[float]] | None = None, fit_base: bool = True,
-              resolution: Resolution = Resolution(), max_iterations: int = 30,
+              resolution: Resolution = Resolution(), max_iterations: int = 30, restarts: int = MAX_RESTARTS,
               on_evaluation: Callable[[int], None] | None = None) -> ModelFit:
     """Fit the base parameters (unless fit_base is False) and the given effects' parameters.
 
+    max_iterations bounds the cost evaluations of each least_squares run (not counting the
+    Jacobian's); up to `restarts` restarts follow a collapsed trust region.
     recordings: training recordings at full rate (decimated here to `resolution.fit_rate_hz`).
     start: warm start; its geometry is replaced by the recordings'. prior: the catheter the
     physical ranges refer to (default: start). effects: {effect id: starting values}.
@@ -125,21 +134,32 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
     layout = ParameterLayout(prior, tuple(effects), fit_base)
     zero_start = np.asarray(zero_offsets_mm, dtype=float)
     runs = 0
+    costs: list[float] = []
 
     def residuals(z: np.ndarray) -> np.ndarray:
         nonlocal runs
         params, zero, values = layout.unpack(z, start, zero_start)
         terms = combined_terms(values)
-        out = [((predict_tips(params, terms, zero, r, resolution) - r.tip_mm)[r.valid]).ravel() for r in prepared]
+        out = np.concatenate([((predict_tips(params, terms, zero, r, resolution) - r.tip_mm)[r.valid]).ravel()
+                              for r in prepared])
+        if not np.all(np.isfinite(out)):   # the solver failed at these parameters: make them unattractive
+            out = np.full_like(out, DIVERGED_RESIDUAL_MM)
         runs += 1
+        costs.append(0.5 * float(out @ out))
         if on_evaluation is not None:
             on_evaluation(runs)
-        return np.concatenate(out)
+        return out
 
-    z0 = layout.pack(start, zero_start, effects)
+    z = layout.pack(start, zero_start, effects)
     low, high = layout.bounds()
-    result = least_squares(residuals, z0, bounds=(low, high), method="trf", diff_step=DIFF_STEP,
-                           ftol=TOLERANCE, xtol=TOLERANCE, gtol=1e-8, max_nfev=max_iterations)
+    for _ in range(1 + restarts):
+        first_run = runs
+        result = least_squares(residuals, z, bounds=(low, high), method="trf", diff_step=DIFF_STEP,
+                               ftol=TOLERANCE, xtol=TOLERANCE, gtol=1e-8, max_nfev=max_iterations)
+        improved = result.cost < (1.0 - RESTART_GAIN) * costs[first_run]
+        z = result.x
+        if result.status != XTOL_REACHED or not improved:
+            break
     params, zero, values = layout.unpack(result.x, start, zero_start)
     std_z, correlation = _statistics(result.jac, result.fun, len(result.x))
     physical = np.array([p.from_z(z) for p, z in zip(layout.parameters, result.x)])

@@ -26,7 +26,7 @@ import numpy as np
 from model.effects.catalog import effect
 from model.gap.calibration import ModelFit, calibrate, rmse_mm, tip_errors
 from model.gap.recording import Recording
-from model.gap.simulation import Resolution
+from model.gap.simulation import Resolution, catheter_for
 from model.params import CatheterParams
 
 PARAMETER_PENALTY = 0.005   # shrink charged per added parameter
@@ -35,6 +35,7 @@ MIN_SHRINK = 0.03           # a meaningful effect removes at least 3 % of the he
 MIN_SHRINK_WITHOUT_NOISE = 0.05   # ... or 5 % when the noise floor is unknown
 MIN_GAIN_OVER_NOISE = 0.1   # ... and at least 10 % of the noise variance 3 sigma^2 (mm^2)
 CANDIDATE_ITERATIONS = 15
+EXPLORE_ITERATIONS = 4       # cost evaluations of each start's exploratory fit
 
 
 @dataclass(frozen=True)
@@ -63,10 +64,34 @@ class CandidateResult:
 
 
 def start_values(effect_id: str) -> tuple[float, ...]:
-    """Where a candidate's fit starts: off (0) where 0 is in range, else its typical value."""
+    """The candidate switched off: 0 where 0 is in range, else its typical value."""
     candidate = effect(effect_id)
     return tuple(0.0 if low <= 0.0 <= high else typ
                  for typ, low, high in zip(candidate.typical, candidate.lower, candidate.upper))
+
+
+def probe_values(effect_id: str) -> list[tuple[float, ...]]:
+    """Starting points worth one model run each.
+
+    Off; then for effects with one-sided parameters 1/4, 1/2 and all of the typical values;
+    for signed ones (directions) each parameter alone at -+1/2 and -+1 of the typical
+    magnitude (three-parameter effects: -+1 only).
+    """
+    candidate = effect(effect_id)
+    off = start_values(effect_id)
+    probes = [off]
+    if min(candidate.lower) >= 0:
+        for fraction in (0.25, 0.5, 1.0):
+            probes.append(tuple(o + fraction * (t - o) for o, t in zip(off, candidate.typical)))
+        return probes
+    magnitude = float(np.linalg.norm(candidate.typical))
+    fractions = (1.0,) if len(candidate.param_names) == 3 else (0.5, 1.0)
+    for k in range(len(off)):
+        for value in (magnitude * f * s for f in fractions for s in (1.0, -1.0)):
+            probe = list(off)
+            probe[k] = float(np.clip(value, candidate.lower[k], candidate.upper[k]))
+            probes.append(tuple(probe))
+    return probes
 
 
 @dataclass(frozen=True)
@@ -83,11 +108,36 @@ class FitTask:
     resolution: Resolution
     iterations: int = CANDIDATE_ITERATIONS
 
+    @property
+    def prepared_train(self) -> list[Recording]:
+        return self.resolution.prepare(self.train)
+
 
 def run_task(task: FitTask) -> CandidateResult:
-    """Fit the task's effects with the base parameters and evaluate them on the held-out data."""
-    fit = calibrate(task.train, task.start.params, prior=task.prior, zero_offsets_mm=task.start.zero_offsets_mm,
-                    effects=task.effects, resolution=task.resolution, max_iterations=task.iterations)
+    """Fit the task's effects with the base parameters and evaluate them on the held-out data.
+
+    Two starts, each explored by a short fit, the better one then fitted to the end:
+    - continuation: the starting fit (baseline) with the new effect off;
+    - fresh: the prior catheter with zero tendon zeros and the new effect at its best probe
+      value (`probe_values`, one model run each). A baseline that lacks an effect has bent its
+      parameters (e.g. its tendon zeros bend the catheter at rest in place of precurvature),
+      and the continuation can stall there.
+    """
+    fixed = dict(task.effects)
+    last = list(fixed)[-1] if fixed else None
+    train = task.prepared_train
+    prior = ModelFit(catheter_for(task.prior, train), (0.0, 0.0, 0.0, 0.0), {})
+    continuation = (task.start, {**fixed, last: start_values(last)} if last else {})
+    fresh_starts = [{**fixed, last: probe} if last else {} for probe in (probe_values(last) if last else [()])]
+    costs = [rmse_mm(tip_errors(ModelFit(prior.params, prior.zero_offsets_mm, effects), train, task.resolution))
+             for effects in fresh_starts]
+    fresh = (prior, fresh_starts[int(np.argmin(costs))])
+    explored = [calibrate(task.train, base.params, prior=task.prior, zero_offsets_mm=base.zero_offsets_mm,
+                          effects=effects, resolution=task.resolution, max_iterations=EXPLORE_ITERATIONS,
+                          restarts=0) for base, effects in (continuation, fresh)]
+    best = min(explored, key=lambda fit: fit.train_rmse_mm)
+    fit = calibrate(task.train, best.params, prior=task.prior, zero_offsets_mm=best.zero_offsets_mm,
+                    effects=best.effects, resolution=task.resolution, max_iterations=task.iterations)
     errors = tuple(tip_errors(fit, task.holdout, task.resolution))
     return evaluate(tuple(task.effects), fit, errors, task.baseline_errors, task.baseline_rmse_mm)
 

@@ -25,7 +25,8 @@ class Resolution:
 
     n_elements: lumped elements (the plant uses 20; 8 moves the tip by < 0.05 mm RMS on the
         standard excitation, well below tracker noise).
-    max_tendon_step_mm, max_insertion_step_mm: quasi-static sub-step sizes (plant: 0.05, 0.5).
+    max_tendon_step_mm, max_insertion_step_mm: quasi-static sub-step sizes (plant: 0.05, 0.5);
+        insertion steps of 2 mm at 8 elements made the kernel return NaN on some paths.
     fit_rate_hz: recordings are decimated to about this rate for fitting and evaluation; the
         smooth excitation loses nothing at 10 Hz, while the cost of a run scales with the
         number of samples plus the path length over the sub-step size.
@@ -33,7 +34,7 @@ class Resolution:
 
     n_elements: int = 8
     max_tendon_step_mm: float = 0.25
-    max_insertion_step_mm: float = 2.0
+    max_insertion_step_mm: float = 0.5
     fit_rate_hz: float = 10.0
 
     def decimation(self, recording: Recording) -> int:

@@ -68,14 +68,12 @@ class ProfilePosition:
             self.acknowledged = False
         return rising and self.pending_target_counts is None
 
-    def set_point_target(self, target_position: int, controlword: int) -> float:
-        """The absolute target (counts) that 0x607A means under bit 6 of ``controlword``."""
-        if controlword & RELATIVE_BIT:
-            return self.last_target_counts + target_position
-        return float(target_position)
-
     def accept(self, target_counts: float, controlword: int) -> None:
-        """Take a set-point (already limited by the drive) and acknowledge it (bit 12)."""
+        """Take a set-point and acknowledge it (bit 12).
+
+        The drive resolves bit 6 first: a relative 0x607A is added to
+        ``last_target_counts``. ``target_counts`` is absolute and already limited.
+        """
         if self.active_target_counts is None or controlword & CHANGE_SET_IMMEDIATELY_BIT:
             self.active_target_counts = target_counts
         else:

@@ -10,7 +10,8 @@ messages with CiA 301/402 error codes and the error register 0x1001.
 
 Two clocks, neither of them read here:
 - motion advances by one communication cycle (0x1006, else the spec's cycle
-  period) per received SYNC frame;
+  period) per received SYNC frame, in every NMT state (the frame is the
+  simulation's clock; only PDO traffic depends on OPERATIONAL);
 - heartbeat production, the heartbeat-consumer timeout and injected faults run
   on ``tick(now_s)``, called with an injected time (tests) or wall time (the
   real-time runner).

@@ -87,6 +87,7 @@ class DriveBench:
         self.recorder = FrameRecorder()
         self.client = canopen.Network()
         self.client.listeners.append(self.recorder)
+        self.client.NOTIFIER_CYCLE = 0.05  # short shutdown
         self.client.connect(interface="virtual", channel=self.channel)
         self.nodes: dict[str, BaseNode402] = {}
         for spec in specs:
@@ -125,7 +126,7 @@ class DriveBench:
         self.barrier(barrier_via)
 
     def operational(self, name: str) -> BaseNode402:
-        """NMT start, TPDO/RPDO maps read from the drive, heartbeat seen once; returns the client node."""
+        """TPDO/RPDO maps read from the drive by SDO, then NMT start; returns the client node."""
         node = self.nodes[name]
         node.tpdo.read()
         node.rpdo.read()

@@ -135,3 +135,22 @@ def test_mapping_of_a_valid_pdo_cannot_be_changed(bench):
     with pytest.raises(SdoAbortedError) as refused:
         node.sdo[0x1A00][0].raw = 0             # TPDO1 is valid (COB-ID bit 31 clear)
     assert refused.value.code == 0x08000022
+
+
+def test_sync_listener_couples_a_plant_cycle_by_cycle(bench):
+    """A trivial plant: tension proportional to tendon travel, 10 N/mm."""
+    drive = bench.drive(DRIVE)
+    node = bench.enable(DRIVE, CSP)
+    steps = []
+
+    def plant_step(can_id, data, timestamp):
+        steps.append(can_id)
+        drive.set_load_tension_n(10.0 * drive.position_actual_mm)
+
+    bench.drive_set.add_sync_listener(plant_step)
+    for k in range(1, 41):                      # 2 mm in 0.2 s, then hold
+        send_rpdo1(node, 0x0F, round(min(k * 0.1, 2.0) * drive.spec.counts_per_mm))
+        bench.sync()
+    assert steps == [0x80] * 40
+    # 2 mm -> 20 N -> 20 N * 5 mm / 10 = 10 mNm = 10 per mille
+    assert bench.tpdo1(DRIVE)[0x6077] == 10

@@ -1,0 +1,97 @@
+"""One SYNC cycle on the bus: host heartbeat, RPDO1 to every drive, SYNC, TPDO1 from every drive.
+
+The cycle is paced by the driver's clock at the configured SYNC period (CiA 301 SYNC, COB-ID
+0x80, no counter byte). The drives latch the set-points at the SYNC and answer it with their
+TPDO1, sampled at that SYNC; ``run`` returns when every drive has answered or the reply time
+has passed (a drive that did not answer is marked not fresh, its heartbeat decides whether it
+is lost).
+
+``quick_stop_all`` may be called from any thread: under the send lock it replaces every
+controlword by quick stop, sends it to every drive at once, and keeps sending it in every
+later cycle.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Sequence
+
+import can
+import canopen
+
+from crest.driver import cia402
+from crest.driver.clock import Clock
+from crest.driver.drive_axis import DriveAxis
+from crest.driver.heartbeat_producer import HeartbeatProducer
+
+SYNC_COB_ID = 0x80
+
+
+class SyncCycle:
+    """The bus side of the control cycle for ``axes``.
+
+    :param reply_timeout_s: wall time to wait for the TPDOs after a SYNC.
+    """
+
+    def __init__(self, network: canopen.Network, clock: Clock, axes: Sequence[DriveAxis], period_s: float,
+                 heartbeat: HeartbeatProducer, feedback_changed: threading.Condition,
+                 reply_timeout_s: float) -> None:
+        self._network = network
+        self._clock = clock
+        self.axes = tuple(axes)
+        self.period_s = period_s
+        self._heartbeat = heartbeat
+        self._feedback_changed = feedback_changed
+        self.reply_timeout_s = reply_timeout_s
+        self._send_lock = threading.Lock()
+        self._override: int | None = None
+        self.next_sync_s: float | None = None
+        self.count = 0
+        self.send_failures: list[str] = []
+
+    @property
+    def started(self) -> bool:
+        return self.next_sync_s is not None
+
+    def run(self) -> tuple[float, tuple[bool, ...]]:
+        """Wait for the SYNC time, send, wait for the replies; (SYNC time s, fresh TPDO1 per axis)."""
+        if self.next_sync_s is None:
+            self.next_sync_s = self._clock.now_s()
+        self._clock.wait_until(self.next_sync_s)
+        now_s = self._clock.now_s()
+        self.next_sync_s = max(self.next_sync_s + self.period_s, now_s)
+        self._heartbeat.poll(now_s)
+        with self._feedback_changed:
+            marks = [axis.tpdo_count for axis in self.axes]
+        with self._send_lock:
+            for axis in self.axes:
+                self._network.send_message(axis.rpdo_cob_id, axis.rpdo_data(self._override))
+                axis.sent_target_counts = axis.target_counts
+            self._network.send_message(SYNC_COB_ID, b"")
+        self.count += 1
+        with self._feedback_changed:
+            self._feedback_changed.wait_for(
+                lambda: all(axis.tpdo_count > mark for axis, mark in zip(self.axes, marks)),
+                timeout=self.reply_timeout_s)
+            fresh = tuple(axis.tpdo_count > mark for axis, mark in zip(self.axes, marks))
+        return now_s, fresh
+
+    def quick_stop_all(self) -> None:
+        """Quick stop to every drive now, and in every later cycle (any thread).
+
+        A drive whose frame cannot be sent (bus-off, adapter gone) does not keep the others
+        from getting theirs; its failure is kept in ``send_failures``.
+        """
+        self.override(cia402.QUICK_STOP)
+
+    def override(self, controlword: int) -> None:
+        """Send ``controlword`` to every drive now and in every later cycle instead of its own."""
+        with self._send_lock:
+            self._override = controlword
+            if self._network.bus is None:
+                return
+            for axis in self.axes:
+                try:
+                    self._network.send_message(axis.rpdo_cob_id, axis.rpdo_data(controlword))
+                except can.CanError as error:
+                    self.send_failures.append(f"{axis.name}: controlword 0x{controlword:04X} not sent ({error})")

@@ -1,0 +1,101 @@
+"""Boot sequence against the simulated drives: NMT, identity, configuration, heartbeat, SYNC."""
+
+from dataclasses import replace
+
+import pytest
+
+from crest.driver import BootError, IdentityMismatch, ReadBackMismatch
+from crest.exit_codes import ExitCode
+from driver_rig import drive_specs, is_sync, make_config, sdo_downloads
+
+
+def test_boot_resets_each_node_before_talking_to_it_and_ends_operational(booted):
+    frames = booted.frames()
+    for axis in booted.config.axes:
+        resets = [i for i, f in enumerate(frames) if f.arbitration_id == 0x000 and bytes(f.data) == bytes([0x81, axis.node_id])]
+        boot_ups = [i for i, f in enumerate(frames) if f.arbitration_id == 0x700 + axis.node_id and bytes(f.data) == b"\x00"]
+        first_sdo = next(i for i, f in enumerate(frames) if f.arbitration_id == 0x600 + axis.node_id)
+        assert len(resets) == 1 and resets[0] < first_sdo, axis.name
+        assert any(resets[0] < i < first_sdo for i in boot_ups), f"{axis.name}: SDO before its boot-up"
+        start = next(i for i, f in enumerate(frames) if f.arbitration_id == 0x000 and bytes(f.data) == bytes([0x01, axis.node_id]))
+        assert start > max(i for i, f in enumerate(frames) if f.arbitration_id == 0x600 + axis.node_id)
+        assert booted.drive(axis.name).nmt_state == "OPERATIONAL"
+        assert booted.drive(axis.name).state.name == "SWITCH_ON_DISABLED"
+
+
+def test_boot_writes_the_axis_parameters_in_counts(booted):
+    config = booted.config
+    for axis in config.axes:
+        node = booted.drive(axis.name).node
+        per_mm = axis.counts_per_mm
+        assert node.value(0x1006) == 10_000                                   # 10 ms SYNC period in us
+        assert node.value(0x6081) == round(axis.max_velocity_mm_s * per_mm)
+        assert node.value(0x6083) == node.value(0x6084) == round(axis.max_acceleration_mm_s2 * per_mm)
+        assert (node.value(0x607D, 1), node.value(0x607D, 2)) == (round(axis.soft_min_mm * per_mm),
+                                                                  round(axis.soft_max_mm * per_mm))
+        assert node.value(0x6065) == round(axis.following_error_window_mm * per_mm)
+        assert node.value(0x605A) == 2
+        assert node.value(0x6098) == axis.homing_method
+        assert node.value(0x1017) == 50
+        assert node.value(0x1016, 1) == 127 << 16 | 250                       # watch node 127, 250 ms
+        assert node.value(0x6061) == 1                                        # profile position
+
+
+def test_identity_is_reported_from_0x1018(make_rig):
+    report = make_rig().testbed.boot()
+    assert {name: identity.serial for name, identity in report.identities.items()} == {
+        "tendon1": 1, "tendon2": 2, "tendon3": 3, "tendon4": 4, "insertion": 5}
+    assert {identity.vendor_id for identity in report.identities.values()} == {0x43525354}
+
+
+def test_host_heartbeat_and_sync_run_at_their_configured_periods(booted):
+    syncs_before = sum(is_sync(f) for f in booted.frames())
+    heartbeats_before = sum(f.arbitration_id == 0x77F for f in booted.frames())
+    for _ in range(30):                                  # 0.3 s of 10 ms cycles
+        booted.testbed.cycle()
+    frames = booted.frames()
+    assert sum(is_sync(f) for f in frames) == syncs_before + 30
+    heartbeats = [f for f in frames if f.arbitration_id == 0x77F][heartbeats_before:]
+    assert len(heartbeats) == 6                          # every 50 ms
+    assert {bytes(f.data) for f in heartbeats} == {b"\x05"}   # OPERATIONAL
+
+
+def short_boot_config():
+    return make_config(boot_timeout_s=0.2)
+
+
+def test_a_missing_drive_fails_the_boot_naming_it(make_rig):
+    config = short_boot_config()
+    rig = make_rig(config=config, specs=[spec for spec in drive_specs(config) if spec.name != "insertion"])
+    with pytest.raises(BootError) as error:
+        rig.testbed.boot()
+    assert error.value.axis == "insertion"
+    assert "boot-up" in str(error.value) and "0x705" in str(error.value)
+
+
+def test_a_drive_of_another_vendor_is_refused(make_rig, tmp_path):
+    config = short_boot_config()
+    eds = tmp_path / "other_vendor.eds"
+    eds.write_text(config.axis("tendon2").eds_path.read_text().replace("0x43525354", "0x00000123"))
+    specs = [replace(spec, eds_path=eds) if spec.name == "tendon2" else spec for spec in drive_specs(config)]
+    rig = make_rig(config=config, specs=specs)
+    with pytest.raises(IdentityMismatch) as error:
+        rig.testbed.boot()
+    assert error.value.axis == "tendon2" and error.value.exit_code == ExitCode.CONFIG
+    assert "0x1018:1 vendor id is 0x00000123" in str(error.value)
+
+
+def test_a_motor_rated_torque_other_than_configured_is_refused(make_rig):
+    config = short_boot_config()
+    specs = [replace(spec, rated_torque_mnm=1000.0) if spec.name == "tendon4" else spec for spec in drive_specs(config)]
+    rig = make_rig(config=config, specs=specs)
+    with pytest.raises(ReadBackMismatch) as error:
+        rig.testbed.boot()
+    assert error.value.axis == "tendon4" and "0x6076" in str(error.value) and "1000 mNm" in str(error.value)
+
+
+def test_consumer_heartbeat_is_the_last_sdo_write_of_every_drive(booted):
+    for axis in booted.config.axes:
+        writes = sdo_downloads(booted.frames(), axis.node_id)
+        boot_writes = [w for w in writes if w[0] != 0x1016 or w[2] != 0]
+        assert boot_writes[-1] == (0x1016, 1, 0x007F00FA), axis.name
