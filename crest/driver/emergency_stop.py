@@ -19,6 +19,8 @@ from crest.driver.cia402 import Cia402State
 from crest.driver.drive_axis import CONTROLWORD, STATUSWORD
 from crest.driver.errors import SdoFailure
 
+RECEIVE_POLL_S = 0.1  # longest the receive thread blocks before it can end
+
 
 def emergency_stop(bus: can.BusABC, config: TestbedConfig) -> dict[str, Cia402State | SdoFailure]:
     """Quick stop to every axis; per axis the state it shows afterwards, or the SDO failure.
@@ -26,6 +28,7 @@ def emergency_stop(bus: can.BusABC, config: TestbedConfig) -> dict[str, Cia402St
     Every axis is tried even if one fails; the bus is left open for its owner.
     """
     network = canopen.Network(bus)
+    network.NOTIFIER_CYCLE = RECEIVE_POLL_S
     network.connect()
     outcome: dict[str, Cia402State | SdoFailure] = {}
     try:

@@ -64,12 +64,24 @@ def check_trajectory(config: TestbedConfig, samples: Sequence[AxisTargets]) -> N
                                               "at rest and smooth the trajectory; nothing was moved")
 
 
+def braking_velocity_mm_s(distance_mm: float, acceleration_mm_s2: float, period_s: float) -> float:
+    """The fastest set-point velocity from which the stream can still stop within ``distance_mm``.
+
+    Each cycle moves v T and the velocity then drops by a T, so stopping from v covers about
+    v^2 / (2 a) + v T / 2; setting that equal to the distance e gives
+
+        v = -a T / 2 + sqrt((a T / 2)^2 + 2 a e).
+    """
+    half_step = acceleration_mm_s2 * period_s / 2.0
+    return -half_step + math.sqrt(half_step * half_step + 2.0 * acceleration_mm_s2 * distance_mm)
+
+
 class SetPointLimiter:
     """Clamps a streamed set-point of one axis into its limits, cycle by cycle.
 
     A set-point that respects the limits passes unchanged. Otherwise the commanded velocity
-    v = (x - p) / T is clamped to +-v_max, to the braking bound sqrt(2 a_max |x - p|) (so the
-    axis can stop on the set-point), and to v_prev +- a_max T; the position to the soft limits.
+    v = (x - p) / T is clamped to +-v_max, to the braking bound (``braking_velocity_mm_s``, so
+    the axis can stop on the set-point), and to v_prev +- a_max T; the position to the soft limits.
     """
 
     def __init__(self, axis: AxisConfig, period_s: float, position_mm: float) -> None:
@@ -94,7 +106,8 @@ class SetPointLimiter:
             message = (f"{axis.name}: set-point {requested_mm:.3f} mm clamped to soft limit {wanted_mm:g} mm")
         if abs(velocity) > axis.max_velocity_mm_s * (1 + PLAN_TOLERANCE) \
                 or abs(velocity - self.velocity_mm_s) > max_change * (1 + PLAN_TOLERANCE):
-            reachable = min(axis.max_velocity_mm_s, math.sqrt(2.0 * axis.max_acceleration_mm_s2 * abs(step_mm)))
+            reachable = min(axis.max_velocity_mm_s, braking_velocity_mm_s(abs(step_mm), axis.max_acceleration_mm_s2,
+                                                                          period_s))
             goal = max(-reachable, min(reachable, velocity))
             velocity = max(self.velocity_mm_s - max_change, min(self.velocity_mm_s + max_change, goal))
             limited_mm = min(max(self.position_mm + velocity * period_s, axis.soft_min_mm), axis.soft_max_mm)

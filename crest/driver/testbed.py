@@ -55,6 +55,8 @@ NMT_START = 0x01
 NMT_ENTER_PRE_OPERATIONAL = 0x80
 #: Shortest wall time to wait for the TPDOs after a SYNC (the longer of this and two periods).
 MIN_REPLY_TIMEOUT_S = 0.02
+#: Longest the CAN receive thread blocks before it looks whether it should end (close waits for it).
+RECEIVE_POLL_S = 0.1
 
 
 @dataclass(frozen=True)
@@ -90,6 +92,7 @@ class Testbed:
         self.config = config
         self.clock = clock if clock is not None else MonotonicClock()
         self._network = canopen.Network(bus)
+        self._network.NOTIFIER_CYCLE = RECEIVE_POLL_S
         feedback_changed = threading.Condition()
         self.axes: dict[str, DriveAxis] = {}
         for name in AXIS_ORDER:

@@ -36,8 +36,8 @@ def test_shipped_config_loads_with_derived_scaling():
     # 4096 counts/rev * 10 : 1 gear over a 5 mm drum: 4096 * 10 / (2 pi 5) counts per mm of tendon.
     assert tendon.counts_per_mm == pytest.approx(4096 * 10 / (2 * math.pi * 5.0))
     assert tendon.counts_to_mm(tendon.mm_to_counts(12.0)) == pytest.approx(12.0, abs=1 / tendon.counts_per_mm)
-    # 1000 per mille of 1000 mN*m, times 10 at the drum, over 5 mm: 2000 N.
-    assert tendon.tension_n_from_torque_permille(1000) == pytest.approx(2000.0)
+    # 1000 per mille of the 100 mN*m rated torque, times 10 at the drum, over 5 mm: 200 N.
+    assert tendon.tension_n_from_torque_permille(1000) == pytest.approx(200.0)
     assert config.insertion_axis.home_position_mm == 20.0
     assert tendon.home_position_mm == 0.0
     assert config.axis("tendon3").eds_path == (SHIPPED.parent / "crest_drive.eds").resolve()

@@ -21,8 +21,8 @@ from sim_backend.drive.drive_spec import DriveSpec
 from sim_backend.drives import SimDriveSet
 
 WAIT_S = 2.0
-#: Where the insertion carriage stands at power-up: 3 mm above its limit switch (home, 20 mm).
-INSERTION_START_MM = 23.0
+#: Where the insertion carriage stands at power-up: 1 mm above its limit switch (home, 20 mm).
+INSERTION_START_MM = 21.0
 #: An identifier no node uses: the rig's marker frame (see Rig.frames).
 MARKER_COB_ID = 0x7FF
 STOPPED_STATES = {"QUICK_STOP_ACTIVE", "SWITCH_ON_DISABLED", "FAULT"}
@@ -89,7 +89,7 @@ class Rig:
         self.channel = f"crest-driver-{uuid.uuid4().hex}"
         self.recorder = FrameRecorder()
         self._recorder_bus = can.Bus(interface="virtual", channel=self.channel)
-        self._recorder_notifier = can.Notifier(self._recorder_bus, [self.recorder])
+        self._recorder_notifier = can.Notifier(self._recorder_bus, [self.recorder], timeout=0.05)
         self.drives = SimDriveSet(specs, self.channel, bitrate_bit_s=config.bus.bitrate,
                                   sync_period_s=config.sync.period_s, faults=faults)
         self.drives.start()

@@ -12,13 +12,13 @@ from driver_rig import INSERTION_START_MM, drive_specs, make_config, sdo_downloa
 def test_homing_references_every_axis_and_pretensions_the_tendons(homed):
     testbed, config = homed.testbed, homed.config
     insertion = config.insertion_axis
-    # Method 17: the carriage ran down onto its switch (3 mm below where it started) and the
+    # Method 17: the carriage ran down onto its switch (1 mm below where it started) and the
     # drive now reports the switch as home_position_mm, the same frame as the mechanism.
     reported_mm = testbed.positions().insertion_mm
     physical_mm = homed.drive("insertion").position_actual_mm
     assert reported_mm == pytest.approx(insertion.home_position_mm, abs=0.05)
     assert reported_mm == pytest.approx(physical_mm, abs=1.0 / insertion.counts_per_mm)
-    assert physical_mm < INSERTION_START_MM - 2.9
+    assert physical_mm < INSERTION_START_MM - 0.9
     # Method 37 on the tendons: current position is zero; then both tendons of each pair are
     # pulled to the pretension (pulls 0, 0).
     pretension_mm = config.coordination.pretension_mm
