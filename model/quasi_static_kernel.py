@@ -143,7 +143,7 @@ def _element_modifiers(n, length, params, effects, tension, bend_prev, points, f
 
 @kernel
 def _sweep(n, h, params, arm, cos_phi, sin_phi, ext_bend, f0, kx, gt, gth, bend_dir, xref, tref, slack,
-           lin_force, dist_force, dist_short):
+           lin_force, dist_force, dist_short, scratch):
     """Tip-to-base sweep: affine maps (4 x 5: constant, then d/dT_tip) of the friction forces.
 
     Stores the map of each element's friction forces (lin_force) and returns the maps of the
@@ -162,13 +162,7 @@ def _sweep(n, h, params, arm, cos_phi, sin_phi, ext_bend, f0, kx, gt, gth, bend_
     kb = params[P_EI] / h
     ka = h / params[P_EA]
     kt = h / params[P_EAT]
-    a = np.empty((4, 4))
-    rhs = np.empty((4, 5))
-    pull = np.empty((4, 5))
-    dp = np.empty((4, 5))
-    w_pull = np.empty(5)
-    d0 = np.empty(4)
-    w = np.empty(4)
+    a, rhs, pull, dp, w_pull, d0, w = scratch
     dist_force[:, :] = 0.0
     dist_short[:, :] = 0.0
     for i in range(n - 1, -1, -1):
@@ -231,7 +225,7 @@ def _apply_d(ka, c, kt, e0, e1, x, out):
 
 
 @kernel
-def _tip_tensions(u, compliance, dist_force, dist_short, slack, revived, tip_tension):
+def _tip_tensions(u, compliance, dist_force, dist_short, slack, revived, tip_tension, scratch):
     """Compatibility with slack tendons: a 4-variable complementarity problem, by active set.
 
     G_k(T) = S_k(T) + c_drive*(T_k + C_k(T)) is the length the tendon path takes up.
@@ -241,16 +235,13 @@ def _tip_tensions(u, compliance, dist_force, dist_short, slack, revived, tip_ten
     model does not resolve partial slack along one tendon.
     Updates `slack` and `revived` in place; returns True if the set of slack tendons changed.
     """
-    g = np.empty((4, 5))
+    g, assumed, active, mat, vec, idx = scratch
     for k in range(4):
         for col in range(5):
             basis = 1.0 if (col == k + 1) else 0.0
             g[k, col] = dist_short[k, col] + compliance * (basis + dist_force[k, col])
-    assumed = slack.copy()
-    active = slack.copy()
-    mat = np.empty((4, 4))
-    vec = np.empty((4, 1))
-    idx = np.empty(4, dtype=np.int64)
+    assumed[:] = slack
+    active[:] = slack
     for _ in range(10):
         nt = 0
         for k in range(4):
@@ -344,7 +335,11 @@ def make_workspace(n):
             np.empty((4, 5)), np.empty((4, 5)), np.empty((4, n)), np.empty((4, n)),
             np.empty((4, n)), np.empty((n, 2)), np.empty(n), np.empty((4, n)), np.empty(4),
             np.zeros(4, dtype=np.bool_), np.empty(n), np.zeros((4, n), dtype=np.bool_), np.empty(4),
-            np.zeros((4, n), dtype=np.bool_))
+            np.zeros((4, n), dtype=np.bool_), np.zeros(4, dtype=np.bool_),
+            (np.empty((4, 4)), np.empty((4, 5)), np.empty((4, 5)), np.empty((4, 5)), np.empty(5), np.empty(4),
+             np.empty(4)),
+            (np.empty((4, 5)), np.zeros(4, dtype=np.bool_), np.zeros(4, dtype=np.bool_), np.empty((4, 4)),
+             np.empty((4, 1)), np.empty(4, dtype=np.int64)))
 
 
 @kernel
@@ -372,7 +367,7 @@ def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_
     (arm, angle, rest_bend, ext_bend, cos_phi, sin_phi, f0, kx, gt, gth, bend_dir, xref, tref, lin_force,
      distal_force, distal_short, dist_force, dist_short, new_force, new_sliding, new_tension,
      new_bend, new_compression, increment, linear_force, revived, lengths, clamped, previous_increment,
-     crossed) = work
+     crossed, slack_before, sweep_scratch, tip_scratch) = work
     _element_modifiers(n, length, params, effects, tension, bend, points, frames,
                        arm, angle, rest_bend, ext_bend)
     for i in range(n):  # tendon k at phi_k = k*90 deg + twist offset
@@ -395,13 +390,13 @@ def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_
     revived[:] = False
     clamped[:, :] = False
     crossed[:, :] = False
-    slack_before = slack.copy()
+    slack_before[:] = slack
     converged = False
     for iteration in range(MAX_NEWTON_ITERATIONS):
         scalars[S_ITERATIONS] += 1.0
         _sweep(n, h, params, arm, cos_phi, sin_phi, ext_bend, f0, kx, gt, gth, bend_dir, xref, tref, slack,
-               lin_force, dist_force, dist_short)
-        if _tip_tensions(u, compliance, dist_force, dist_short, slack, revived, tip_tension):
+               lin_force, dist_force, dist_short, sweep_scratch)
+        if _tip_tensions(u, compliance, dist_force, dist_short, slack, revived, tip_tension, tip_scratch):
             continue
         worst = 0.0
         ka = h / params[P_EA]

@@ -23,6 +23,8 @@ from crest.driver.errors import MotionRefused
 #: Slack on the velocity and acceleration checks of a planned trajectory: set-points are
 #: usually computed in floating point right at the limit.
 PLAN_TOLERANCE = 1e-6
+#: A caught-up set-point this close to the requested one is the requested one (float rounding).
+LANDING_TOLERANCE_MM = 1e-9
 
 
 def check_positions(config: TestbedConfig, targets: AxisTargets, what: str = "target") -> None:
@@ -79,9 +81,11 @@ def braking_velocity_mm_s(distance_mm: float, acceleration_mm_s2: float, period_
 class SetPointLimiter:
     """Clamps a streamed set-point of one axis into its limits, cycle by cycle.
 
-    A set-point that respects the limits passes unchanged. Otherwise the commanded velocity
-    v = (x - p) / T is clamped to +-v_max, to the braking bound (``braking_velocity_mm_s``, so
-    the axis can stop on the set-point), and to v_prev +- a_max T; the position to the soft limits.
+    A set-point that respects the limits passes unchanged. Otherwise the limiter catches up:
+    the commanded velocity v = (x - p) / T is clamped to +-v_max, to the braking bound
+    (``braking_velocity_mm_s``, so the axis can stop on the set-point), and to v_prev +- a_max T;
+    the position to the soft limits. It keeps catching up (braking included) until it stands
+    on the set-point slowly enough to stop within one cycle.
     """
 
     def __init__(self, axis: AxisConfig, period_s: float, position_mm: float) -> None:
@@ -93,29 +97,37 @@ class SetPointLimiter:
         """Start from rest at ``position_mm``."""
         self.position_mm = position_mm
         self.velocity_mm_s = 0.0
+        self._catching_up = False
 
     def limit(self, requested_mm: float) -> tuple[float, str | None]:
         """(set-point to send, None or a message saying what was clamped and why)."""
         axis, period_s = self.axis, self.period_s
-        wanted_mm = min(max(requested_mm, axis.soft_min_mm), axis.soft_max_mm)
+        low_mm, high_mm = axis.soft_min_mm, axis.soft_max_mm
+        wanted_mm = min(max(requested_mm, low_mm), high_mm)
         step_mm = wanted_mm - self.position_mm
         velocity = step_mm / period_s
         max_change = axis.max_acceleration_mm_s2 * period_s
-        message = None
-        if wanted_mm != requested_mm:
-            message = (f"{axis.name}: set-point {requested_mm:.3f} mm clamped to soft limit {wanted_mm:g} mm")
-        if abs(velocity) > axis.max_velocity_mm_s * (1 + PLAN_TOLERANCE) \
-                or abs(velocity - self.velocity_mm_s) > max_change * (1 + PLAN_TOLERANCE):
-            reachable = min(axis.max_velocity_mm_s, braking_velocity_mm_s(abs(step_mm), axis.max_acceleration_mm_s2,
-                                                                          period_s))
+        feasible = (abs(velocity) <= axis.max_velocity_mm_s * (1 + PLAN_TOLERANCE)
+                    and abs(velocity - self.velocity_mm_s) <= max_change * (1 + PLAN_TOLERANCE))
+        if feasible and not self._catching_up:
+            set_point_mm = wanted_mm
+        else:
+            reachable = min(axis.max_velocity_mm_s,
+                            braking_velocity_mm_s(abs(step_mm), axis.max_acceleration_mm_s2, period_s))
             goal = max(-reachable, min(reachable, velocity))
             velocity = max(self.velocity_mm_s - max_change, min(self.velocity_mm_s + max_change, goal))
-            limited_mm = min(max(self.position_mm + velocity * period_s, axis.soft_min_mm), axis.soft_max_mm)
-            velocity = (limited_mm - self.position_mm) / period_s
+            set_point_mm = min(max(self.position_mm + velocity * period_s, low_mm), high_mm)
+            if abs(set_point_mm - wanted_mm) < LANDING_TOLERANCE_MM:
+                set_point_mm = wanted_mm
+            velocity = (set_point_mm - self.position_mm) / period_s
+            self._catching_up = not (set_point_mm == wanted_mm and abs(velocity) <= max_change)
+        message = None
+        if set_point_mm != wanted_mm:
             message = (f"{axis.name}: set-point {requested_mm:.3f} mm needs {step_mm / period_s:.1f} mm/s from "
-                       f"{self.position_mm:.3f} mm; limited to {limited_mm:.3f} mm by max_velocity_mm_s "
+                       f"{self.position_mm:.3f} mm; limited to {set_point_mm:.3f} mm by max_velocity_mm_s "
                        f"{axis.max_velocity_mm_s:g} / max_acceleration_mm_s2 {axis.max_acceleration_mm_s2:g}")
-            wanted_mm = limited_mm
+        elif wanted_mm != requested_mm:
+            message = f"{axis.name}: set-point {requested_mm:.3f} mm clamped to soft limit {wanted_mm:g} mm"
         self.velocity_mm_s = velocity
-        self.position_mm = wanted_mm
-        return wanted_mm, message
+        self.position_mm = set_point_mm
+        return set_point_mm, message

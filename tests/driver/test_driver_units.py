@@ -127,8 +127,8 @@ def test_a_trajectory_must_start_and_end_at_rest():
     with pytest.raises(MotionRefused, match="sample 1: acceleration 300.0 mm/s\\^2") as refused:
         check_trajectory(config, [at_rest] + [AxisTargets((0.03 * k,) + (0.0,) * 3, 30.0) for k in range(1, 4)])
     assert refused.value.axis == "tendon1"
-    with pytest.raises(MotionRefused, match="after the last sample"):
-        check_trajectory(config, [at_rest] * 3 + [AxisTargets((0.015,) + (0.0,) * 3, 30.0)])
+    with pytest.raises(MotionRefused, match="after the last sample"):   # 3 mm/s to rest in one cycle
+        check_trajectory(config, [at_rest] + [AxisTargets((x,) + (0.0,) * 3, 30.0) for x in (0.01, 0.03, 0.06)])
     check_trajectory(config, [at_rest] * 3 + [AxisTargets((0.005,) + (0.0,) * 3, 30.0)])   # 50 mm/s^2 both ways
 
 
