@@ -61,10 +61,6 @@ _STATUSWORD_PATTERNS = (  # (mask, value, state), table in the module docstring
 
 #: States in which the power stage may drive the motor.
 ENERGISED_STATES = frozenset({Cia402State.OPERATION_ENABLED, Cia402State.QUICK_STOP_ACTIVE})
-#: States a safety stop may leave an axis in: no motion is commanded in any of them.
-STOPPED_STATES = frozenset({Cia402State.QUICK_STOP_ACTIVE, Cia402State.SWITCH_ON_DISABLED,
-                            Cia402State.READY_TO_SWITCH_ON, Cia402State.SWITCHED_ON,
-                            Cia402State.FAULT_REACTION_ACTIVE, Cia402State.FAULT})
 
 
 def state_from_statusword(statusword: int) -> Cia402State:
@@ -92,7 +88,6 @@ HALT = 0x0100
 TARGET_REACHED = 0x0400
 SET_POINT_ACKNOWLEDGE = 0x1000   # profile position
 HOMING_ATTAINED = 0x1000         # homing
-FOLLOWS_COMMAND = 0x1000         # cyclic synchronous position
 FOLLOWING_ERROR = 0x2000         # profile position, cyclic synchronous position
 HOMING_ERROR = 0x2000            # homing
 

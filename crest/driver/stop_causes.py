@@ -9,6 +9,8 @@ code -> EMCY. 0x0000 (error reset) is not a fault.
 
 from __future__ import annotations
 
+import math
+
 import can
 from canopen.emcy import EmcyError
 
@@ -78,8 +80,10 @@ def following_error_cause(axis: str, detail: str) -> StopCause:
 
 
 def tracker_cause(age_s: float, limit_s: float) -> StopCause:
-    return StopCause(ExitCode.TRACKER_LOST, "tracker", f"no valid tip sample for {age_s:.3f} s "
-                                                       f"(loss_timeout_s {limit_s:g} s) during a closed-loop run")
+    """``age_s`` is inf when no valid tip sample has arrived at all."""
+    since = "yet" if math.isinf(age_s) else f"for {age_s:.3f} s"
+    return StopCause(ExitCode.TRACKER_LOST, "tracker", f"no valid tip sample {since} (loss_timeout_s {limit_s:g} s) "
+                                                       "during a closed-loop run; check the sensor and its cable")
 
 
 def exception_cause(error: BaseException) -> StopCause:

@@ -20,6 +20,9 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+#: Distances below this are no move (far below one encoder count; avoids dividing by ~0).
+NEGLIGIBLE_MM = 1e-9
+
 
 @dataclass(frozen=True)
 class AxisProfile:
@@ -39,7 +42,7 @@ class SynchronizedMove:
 def synchronized_move(distances_mm: Sequence[float], max_velocity_mm_s: Sequence[float],
                       max_acceleration_mm_s2: Sequence[float]) -> SynchronizedMove:
     """The shortest common-timing move (module docstring); a zero distance gets a zero profile."""
-    lengths = [abs(distance) for distance in distances_mm]
+    lengths = [abs(distance) if abs(distance) > NEGLIGIBLE_MM else 0.0 for distance in distances_mm]
     d_v = max((d / v for d, v in zip(lengths, max_velocity_mm_s)), default=0.0)
     d_a = max((d / a for d, a in zip(lengths, max_acceleration_mm_s2)), default=0.0)
     if d_v == 0.0 and d_a == 0.0:

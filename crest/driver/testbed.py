@@ -165,15 +165,12 @@ class Testbed:
         return self
 
     def __exit__(self, exc_type, exc_value, traceback) -> None:
-        if exc_value is None or isinstance(exc_value, SafetyStop):
+        """Ctrl-C or an exception in the block: safety stop, then SafetyStop from it; else close."""
+        if isinstance(exc_value, (Exception, KeyboardInterrupt)) and not isinstance(exc_value, SafetyStop):
+            stop = self._runner.trip_and_stop(exc_value)
             self.close()
-            return
-        if not isinstance(exc_value, (Exception, KeyboardInterrupt)):
-            self.close()
-            return
-        stop = self._runner.trip_and_stop(exc_value)
+            raise stop from exc_value
         self.close()
-        raise stop from exc_value
 
     # --- safety ------------------------------------------------------------------------------
     def on_safety_stop(self, callback: Callable[[SafetyStop], None]) -> None:
@@ -251,6 +248,21 @@ class Testbed:
                 return self._runner.cycle()
             return self._stream(targets)
 
+    def hold(self, duration_s: float) -> CycleSample:
+        """Keep cycling for ``duration_s`` (clock time) with the current commands.
+
+        Heartbeat and SYNC come from the cycle, so a caller that waits (for a key, a user, a
+        plot) must keep calling ``cycle`` or ``hold``: the drives stop themselves when the host
+        is silent for heartbeat_timeout_s.
+        """
+        with self._guarded():
+            self._require_booted()
+            end_s = self.clock.now_s() + duration_s
+            sample = self._runner.cycle()
+            while self.clock.now_s() < end_s:
+                sample = self._runner.cycle()
+            return sample
+
     def run_trajectory(self, samples: Sequence[AxisTargets],
                        on_sample: Callable[[CycleSample], None] | None = None) -> list[CycleSample]:
         """Check a trajectory (one sample per SYNC period) against every limit, move to its first
@@ -274,12 +286,15 @@ class Testbed:
             rows = []
             for axis in self._axis_list:
                 read = axis.sdo.read
-                rows.append(AxisStatus(
+                statusword = read(STATUSWORD, 0, "status")
+                position_counts = read(POSITION_ACTUAL, 0, "status")
+                following_error_counts = read(FOLLOWING_ERROR_ACTUAL, 0, "status")
+                error_code = read(ERROR_CODE, 0, "status")
+                rows.append(AxisStatus(  # NMT state last: the SDO replies came after any earlier heartbeat
                     axis=axis.name, node_id=axis.config.node_id, nmt_state=self._heartbeats.nmt_state(axis.name),
-                    state=cia402.state_from_statusword(read(STATUSWORD, 0, "status")),
-                    position_mm=axis.config.counts_to_mm(read(POSITION_ACTUAL, 0, "status")),
-                    following_error_mm=axis.config.counts_to_mm(read(FOLLOWING_ERROR_ACTUAL, 0, "status")),
-                    error_code=read(ERROR_CODE, 0, "status")))
+                    state=cia402.state_from_statusword(statusword),
+                    position_mm=axis.config.counts_to_mm(position_counts),
+                    following_error_mm=axis.config.counts_to_mm(following_error_counts), error_code=error_code))
             return tuple(rows)
 
     # --- set-points ------------------------------------------------------------------------------
@@ -297,8 +312,8 @@ class Testbed:
 
     # --- internals ------------------------------------------------------------------------------
     def _require_booted(self) -> None:
-        if not self._runner.sync.started:
-            raise DriveError(None, "the testbed is not booted; call boot() first")
+        if not self._runner.sync.started or self._network.notifier is None:
+            raise DriveError(None, "the testbed is not booted (or was closed); call boot() first")
 
     def _ensure_enabled(self) -> None:
         self._require_booted()

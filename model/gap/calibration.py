@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares
 
+from model.dahl_catheter import ModelSolverError
 from model.effects.catalog import combined_terms, effect
 from model.gap.free_parameters import ParameterLayout
 from model.gap.recording import Recording
@@ -107,10 +108,22 @@ def rmse_mm(errors: Sequence[np.ndarray]) -> float:
 
 
 def tip_errors(fit: ModelFit, recordings: Sequence[Recording], resolution: Resolution) -> list[np.ndarray]:
-    """Model minus measured tip [n_valid, 3] per recording (recordings already at the fit resolution)."""
+    """Model minus measured tip [n_valid, 3] per recording (recordings already at the fit resolution).
+
+    Where the model diverges at these parameters the errors are infinite.
+    """
     terms = fit.terms()
     zero = np.asarray(fit.zero_offsets_mm)
-    return [(predict_tips(fit.params, terms, zero, r, resolution) - r.tip_mm)[r.valid] for r in recordings]
+    errors = []
+    for r in recordings:
+        try:
+            tips = predict_tips(fit.params, terms, zero, r, resolution)
+        except ModelSolverError:
+            tips = np.full(r.tip_mm.shape, np.inf)
+        error = (tips - r.tip_mm)[r.valid]
+        error[~np.isfinite(error)] = np.inf
+        errors.append(error)
+    return errors
 
 
 def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: CatheterParams | None = None,
@@ -139,9 +152,7 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
     def residuals(z: np.ndarray) -> np.ndarray:
         nonlocal runs
         params, zero, values = layout.unpack(z, start, zero_start)
-        terms = combined_terms(values)
-        out = np.concatenate([((predict_tips(params, terms, zero, r, resolution) - r.tip_mm)[r.valid]).ravel()
-                              for r in prepared])
+        out = np.concatenate(tip_errors(ModelFit(params, tuple(zero), values), prepared, resolution)).ravel()
         if not np.all(np.isfinite(out)):   # the solver failed at these parameters: make them unattractive
             out = np.full_like(out, DIVERGED_RESIDUAL_MM)
         runs += 1

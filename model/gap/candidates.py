@@ -55,12 +55,17 @@ class CandidateResult:
         return sum(len(effect(effect_id).param_names) for effect_id in self.effects)
 
     def as_dict(self) -> dict:
+        """Plain JSON-able summary; a model that diverged on held-out data has None for its numbers."""
+        def number(value: float) -> float | None:
+            return float(value) if np.isfinite(value) else None
+
+        params = self.fit.effect_params()
         return {"effect": "+".join(self.effects) if self.effects else "none", "effects": list(self.effects),
-                "params": self.fit.effect_params() if len(self.effects) > 1
-                else self.fit.effect_params().get(self.effects[0], {}) if self.effects else {},
-                "n_params": self.n_params, "train_rmse_mm": self.fit.train_rmse_mm,
-                "holdout_rmse_mm": self.holdout_rmse_mm, "shrink": self.shrink,
-                "signature_match": self.signature_match, "score": self.score, "flags": list(self.fit.flags)}
+                "params": params if len(self.effects) != 1 else params[self.effects[0]],
+                "n_params": self.n_params, "train_rmse_mm": number(self.fit.train_rmse_mm),
+                "holdout_rmse_mm": number(self.holdout_rmse_mm), "shrink": number(self.shrink),
+                "signature_match": self.signature_match, "score": number(self.score),
+                "diverged": not np.isfinite(self.holdout_rmse_mm), "flags": list(self.fit.flags)}
 
 
 def start_values(effect_id: str) -> tuple[float, ...]:
@@ -150,7 +155,7 @@ def evaluate(effects: tuple[str, ...], fit: ModelFit, errors: Sequence[np.ndarra
     e = np.concatenate(baseline_errors).ravel()
     c = np.concatenate(errors).ravel() - e
     norm = np.linalg.norm(c) * np.linalg.norm(e)
-    match = float(-(c @ e) / norm) if norm > 0 else 0.0
+    match = float(-(c @ e) / norm) if np.isfinite(norm) and norm > 0 else 0.0
     n_params = sum(len(effect(effect_id).param_names) for effect_id in effects)
     score = shrink - PARAMETER_PENALTY * n_params + SIGNATURE_WEIGHT * match
     return CandidateResult(effects, fit, holdout_rmse, tuple(errors), shrink, match, score)

@@ -99,3 +99,26 @@ def test_consumer_heartbeat_is_the_last_sdo_write_of_every_drive(booted):
         writes = sdo_downloads(booted.frames(), axis.node_id)
         boot_writes = [w for w in writes if w[0] != 0x1016 or w[2] != 0]
         assert boot_writes[-1] == (0x1016, 1, 0x007F00FA), axis.name
+
+
+def test_holding_keeps_the_drives_alive_past_their_heartbeat_timeout(booted):
+    booted.testbed.enable()
+    sample = booted.testbed.hold(1.0)                      # four heartbeat timeouts
+    assert sample.t_s >= 1.0
+    assert set(booted.drive_states().values()) == {"OPERATION_ENABLED"}
+    assert booted.testbed.safety_stop is None
+
+
+def test_status_reads_state_position_and_fault_of_every_axis(make_rig):
+    from sim_backend.faults import FaultKind
+    rig = make_rig()
+    rig.drive("tendon2").inject_fault(FaultKind.EMCY)     # before any host: nothing to stop
+    rig.testbed.connect()
+    for _ in range(6):
+        rig.advance(0.01)                                 # one drive heartbeat period
+    rows = {row.axis: row for row in rig.testbed.status()}
+    assert rows["tendon2"].state.name == "FAULT" and rows["tendon2"].fault == "0x2310 (continuous over current)"
+    assert rows["tendon1"].state.name == "SWITCH_ON_DISABLED" and rows["tendon1"].fault == ""
+    assert {row.nmt_state for row in rows.values()} == {"PRE-OPERATIONAL"}
+    assert rows["insertion"].position_mm == pytest.approx(21.0, abs=1e-3)   # where the carriage stands
+    assert rows["insertion"].node_id == 5 and rows["insertion"].following_error_mm == 0.0

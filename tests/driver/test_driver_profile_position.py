@@ -37,16 +37,23 @@ def test_antagonistic_tendons_keep_the_pretension_all_the_way(homed):
 
 
 def test_the_slowest_axis_runs_at_its_limit_and_the_others_in_proportion(homed):
-    """Insertion 40 mm at 10 mm/s sets the pace; tendon 1 (5 mm) runs 5/40 of that speed."""
+    """Insertion 40 mm at 10 mm/s sets the pace; tendon 1 (5 mm) gets 5/40 of that profile speed."""
     start = len(tpdo_positions_mm(homed, "insertion"))
     homed.testbed.move_to(homed.testbed.targets_from_pulls(-5.0, 5.0, 60.0))
+    insertion, tendon1 = homed.config.insertion_axis, homed.config.axis("tendon1")
+    distance_mm = 60.0 - homed.testbed.axes["insertion"].config.home_position_mm
+    profile_counts_s = {name: homed.drive(name).node.value(0x6081) for name in ("tendon1", "insertion")}
+    assert profile_counts_s["insertion"] == round(insertion.max_velocity_mm_s * insertion.counts_per_mm)
+    assert tendon1.counts_to_mm(profile_counts_s["tendon1"]) == pytest.approx(
+        insertion.max_velocity_mm_s * 5.0 / distance_mm, rel=0.01)
     period_s = homed.config.sync.period_s
     peaks = {}
     for name in ("tendon1", "insertion"):
         positions = tpdo_positions_mm(homed, name)[start:]
         peaks[name] = max(abs(b - a) / period_s for a, b in zip(positions, positions[1:]))
-    assert peaks["insertion"] == pytest.approx(homed.config.insertion_axis.max_velocity_mm_s, rel=0.02)
-    assert peaks["tendon1"] == pytest.approx(peaks["insertion"] * 5.0 / 40.0, rel=0.03)
+    # The motors follow their profiles; catching up the servo lag may briefly take a few % more.
+    assert peaks["insertion"] == pytest.approx(insertion.max_velocity_mm_s, rel=0.05)
+    assert peaks["tendon1"] == pytest.approx(peaks["insertion"] * 5.0 / distance_mm, rel=0.05)
 
 
 def test_set_point_handshake_on_the_wire(homed):

@@ -1,0 +1,39 @@
+"""Calibrate and diagnose from log files: the path `crest fit`, `crest gap` and the blind benchmark share.
+
+Only the files are seen: what produced them (hardware, virtual testbed, a model plant with a
+hidden effect) is not an input.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from crest.gap.log_recordings import load_recordings
+from model import CatheterParams
+from model.gap.calibration import ModelFit, calibrate
+from model.gap.diagnosis import DiagnosisSettings, diagnose
+
+
+def prior_catheter(catheter_toml: Path | str | None) -> CatheterParams:
+    """The starting catheter: the given TOML or configs/catheter.toml."""
+    return CatheterParams.from_toml(catheter_toml) if catheter_toml else CatheterParams.from_toml()
+
+
+def calibrate_logs(train: Sequence[Path | str], catheter_toml: Path | str | None = None,
+                   settings: DiagnosisSettings = DiagnosisSettings(),
+                   progress: Callable[[str], None] | None = None) -> ModelFit:
+    """Fit the base model to the training logs (geometry from their sidecars)."""
+    prior = prior_catheter(catheter_toml)
+    recordings = load_recordings(train)
+    say = progress or (lambda message: None)
+    return calibrate(recordings, prior, prior=prior, resolution=settings.resolution,
+                     max_iterations=settings.baseline_iterations,
+                     on_evaluation=lambda n: say(f"fit: {n} model runs") if n % 50 == 0 else None)
+
+
+def diagnose_logs(train: Sequence[Path | str], holdout: Sequence[Path | str],
+                  catheter_toml: Path | str | None = None, settings: DiagnosisSettings = DiagnosisSettings(),
+                  progress: Callable[[str], None] | None = None) -> dict:
+    """The gap diagnosis (model.gap.diagnosis.diagnose) of training and held-out logs."""
+    return diagnose(load_recordings(train), load_recordings(holdout), prior_catheter(catheter_toml), settings,
+                    progress)

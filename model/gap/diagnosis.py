@@ -1,0 +1,168 @@
+"""The gap diagnosis: baseline, where the gap lies, which effect explains it, how far it shrinks.
+
+1. Baseline: calibrate the base model on the training recordings; tip RMSE on training and held-out.
+2. Where: break the held-out residual down by region (`regions`) and compute its signatures.
+3. Which: fit every candidate effect (and a plain refit, the control) in parallel, rank them by
+   held-out score (`candidates`); the best is chosen only if it removes more than noise can
+   explain, else the verdict is `none` with a description of the unexplained residual. A second
+   effect is added by greedy forward selection among the next best candidates, again only if
+   it is meaningful.
+4. How far: held-out RMSE before and after, shrink overall and per region, and how the base
+   parameters moved when the effect was added.
+The result is a plain, JSON-able dict (see `diagnose`).
+"""
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from model.effects.catalog import EFFECTS
+from model.gap.calibration import ModelFit, calibrate, rmse_mm, tip_errors
+from model.gap.candidates import (CANDIDATE_ITERATIONS, CandidateResult, FitTask, evaluate, is_meaningful, ranked,
+                                  run_tasks, start_values)
+from model.gap.free_parameters import N_BASE
+from model.gap.noise import tracker_noise_mm
+from model.gap.recording import Recording, RecordingError
+from model.gap.regions import breakdown, concentrated, regions, shrink_by_region
+from model.gap.sample_features import compute_features
+from model.gap.signatures import describe, signatures
+from model.gap.simulation import Resolution, predict_tips, predict_tips_and_tension
+from model.params import CatheterParams
+
+FORMAT = "crest-gap/1"
+
+
+@dataclass(frozen=True)
+class DiagnosisSettings:
+    """How the diagnosis runs. workers: parallel candidate fits; pair_candidates: how many of the
+    next best single candidates are tried as a second effect."""
+
+    resolution: Resolution = Resolution()
+    workers: int = 2
+    baseline_iterations: int = 40
+    candidate_iterations: int = CANDIDATE_ITERATIONS
+    pair_candidates: int = 3
+    effects: tuple[str, ...] = tuple(EFFECTS)
+
+
+def diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: CatheterParams,
+             settings: DiagnosisSettings = DiagnosisSettings(),
+             progress: Callable[[str], None] | None = None) -> dict:
+    """Diagnose the gap between the model (starting from `prior`) and the recordings.
+
+    Returns {"format", "baseline", "where", "concentrated", "signatures", "candidates", "pairs",
+    "verdict", "settings", "timing_s"}; "verdict" holds "effect" (best id or "none"), "effects"
+    (all selected), "holdout_rmse_before_mm", "holdout_rmse_after_mm" and "shrink" (0..1).
+    """
+    if not train or not holdout:
+        raise RecordingError("the diagnosis needs at least one training and one held-out recording")
+    say = progress or (lambda message: None)
+    res = settings.resolution
+    clock = time.perf_counter()
+    timing: dict[str, float] = {}
+
+    say(f"baseline: calibrating on {len(train)} training recording(s)")
+    baseline = calibrate(train, prior, prior=prior, resolution=res, max_iterations=settings.baseline_iterations,
+                         on_evaluation=lambda n: say(f"baseline: {n} model runs") if n % 50 == 0 else None)
+    held = res.prepare(holdout)
+    base_errors = _holdout_errors(baseline, held, res)
+    base_rmse = rmse_mm(base_errors)
+    noise = tracker_noise_mm(list(train) + list(holdout))
+    timing["baseline"] = time.perf_counter() - clock
+
+    def task(effects: dict, start: ModelFit) -> FitTask:
+        return FitTask(effects, start, prior, tuple(train), tuple(held), tuple(base_errors), base_rmse, res,
+                       settings.candidate_iterations)
+
+    ids = list(settings.effects)
+    say(f"candidates: fitting {len(ids)} effects and a plain refit on {settings.workers} worker(s)")
+    done = []
+    results = run_tasks([task({}, baseline)] + [task({i: start_values(i)}, baseline) for i in ids],
+                        settings.workers, lambda r: done.append(r) or say(
+                            f"candidates: {len(done)}/{len(ids) + 1} done ({'+'.join(r.effects) or 'refit'})"))
+    refit, singles = results[0], results[1:]
+    if refit.fit.train_rmse_mm < baseline.train_rmse_mm:   # the control got further: it is the baseline
+        baseline, base_errors, base_rmse = refit.fit, list(refit.holdout_errors), refit.holdout_rmse_mm
+        singles = [evaluate(r.effects, r.fit, r.holdout_errors, base_errors, base_rmse) for r in singles]
+    singles = ranked(singles)
+    timing["candidates"] = time.perf_counter() - clock - sum(timing.values())
+
+    chosen: list[CandidateResult] = []
+    pairs: list[CandidateResult] = []
+    best = singles[0]
+    if is_meaningful(base_rmse, best.holdout_rmse_mm, noise):
+        chosen = [best]
+        others = [r.effects[0] for r in singles[1:1 + settings.pair_candidates]]
+        say(f"pairs: {best.effects[0]} with each of {', '.join(others)}")
+        pairs = ranked(run_tasks([task({**best.fit.effects, other: start_values(other)}, best.fit)
+                                  for other in others], settings.workers))
+        if pairs and is_meaningful(best.holdout_rmse_mm, pairs[0].holdout_rmse_mm, noise):
+            chosen.append(pairs[0])
+    timing["pairs"] = time.perf_counter() - clock - sum(timing.values())
+
+    say("where: residual by region and signatures")
+    zeros = baseline.zero_offsets_mm
+    tensions = [predict_tips_and_tension(baseline.params, baseline.terms(), np.asarray(zeros), r, res)[1]
+                if r.tendon_force_n is None else None for r in held]
+    features = compute_features(held, zeros, tensions)
+    found = regions(features)
+    base_stack = np.concatenate(base_errors)
+    where = breakdown(found, base_stack)
+    model_tips = [predict_tips(baseline.params, baseline.terms(), np.asarray(zeros), r, res) for r in held]
+    signature = signatures(features, base_stack, held, model_tips, zeros, noise)
+    final = chosen[-1] if chosen else None
+    after_stack = np.concatenate(final.holdout_errors) if final else base_stack
+    timing["where"] = time.perf_counter() - clock - sum(timing.values())
+
+    verdict = {
+        "effect": best.effects[0] if chosen else "none",
+        "effects": list(final.effects) if final else [],
+        "holdout_rmse_before_mm": base_rmse,
+        "holdout_rmse_after_mm": final.holdout_rmse_mm if final else base_rmse,
+        "shrink": final.shrink if final else 0.0,
+        "params": final.fit.effect_params() if final else {},
+        "shrink_by_region": shrink_by_region(found, base_stack, after_stack) if final else [],
+        "base_parameter_change": _base_change(baseline, final.fit) if final else [],
+        "residual": describe(signature, breakdown(found, after_stack), rmse_mm([after_stack])),
+        "fit": (final.fit if final else baseline).as_dict(),
+    }
+    timing["total"] = time.perf_counter() - clock
+    return {
+        "format": FORMAT,
+        "baseline": {"train_rmse_mm": baseline.train_rmse_mm, "holdout_rmse_mm": base_rmse, "noise_mm": noise,
+                     "noise_floor_mm": None if noise is None else float(np.sqrt(3) * noise),
+                     "fit": baseline.as_dict()},
+        "where": where,
+        "concentrated": [row["region"] for row in concentrated(where)],
+        "signatures": signature,
+        "candidates": [r.as_dict() for r in singles],
+        "pairs": [r.as_dict() for r in pairs],
+        "verdict": verdict,
+        "settings": {**asdict(settings), "train": [r.name for r in train], "holdout": [r.name for r in holdout],
+                     "geometry": {"tendon_offset_mm": baseline.params.tendon_offset_mm,
+                                  "flexible_length_mm": train[0].flexible_length_mm}},
+        "timing_s": timing,
+    }
+
+
+def _holdout_errors(fit: ModelFit, held: Sequence[Recording], res: Resolution) -> list[np.ndarray]:
+    errors = tip_errors(fit, held, res)
+    if not all(np.isfinite(e).all() for e in errors):
+        raise RecordingError("the calibrated model diverged on the held-out recordings; check that they come "
+                             "from the same catheter as the training recordings")
+    return errors
+
+
+def _base_change(before: ModelFit, after: ModelFit) -> list[dict]:
+    """How each base parameter moved when the effect was added (relative for stiffness and friction)."""
+    rows = []
+    for name, a, b, std in zip(before.names[:N_BASE], before.values[:N_BASE], after.values[:N_BASE],
+                               before.std[:N_BASE]):
+        rows.append({"name": name, "baseline": a, "with_effect": b, "change": b - a,
+                     "relative_change": (b - a) / a if a != 0 and not name.startswith("tendon_zero") else None,
+                     "baseline_std": std})
+    return rows
+
