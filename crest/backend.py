@@ -16,6 +16,7 @@ from crest.config import TestbedConfig
 from crest.config.testbed_config import AxisConfig
 
 _channel_numbers = itertools.count(1)
+INSERTION_START_ABOVE_HOME_MM = 2.0   # the simulated pulley block powers up this far from its switch
 
 
 class BackendError(ValueError):
@@ -33,6 +34,12 @@ class Backend:
     @property
     def is_virtual(self) -> bool:
         return self.virtual is not None
+
+    def monitor_bus(self) -> can.BusABC | None:
+        """A second handle that sees every frame on the bus, the host's included (virtual bus only)."""
+        if self.virtual is None:
+            return None
+        return can.Bus(interface="virtual", channel=self.virtual.channel)
 
     def tick(self, now_s: float) -> None:
         """Advance the simulator's time-based duties (deterministic use); no-op on hardware."""
@@ -79,8 +86,7 @@ def _open_virtual(config: TestbedConfig, plant_spec: str | None, fault_texts: Se
     faults = [parse_fault(text) for text in fault_texts]
     plant_config = PlantConfig.from_toml().with_effects(effects)
     plant = load_plant(plant_spec) if plant_spec else DahlPlant(plant_config)
-    free_length_mm = plant_config.params.free_length_mm
-    specs = [_drive_spec(config, axis, free_length_mm) for axis in config.axes]
+    specs = [_drive_spec(config, axis) for axis in config.axes]
     # The virtual bus is in-process: a channel of our own per testbed keeps testbeds apart.
     channel = f"{config.bus.channel}-{os.getpid()}-{next(_channel_numbers)}"
     testbed = VirtualTestbed(specs, channel, plant, bitrate_bit_s=config.bus.bitrate,
@@ -93,7 +99,7 @@ def _open_virtual(config: TestbedConfig, plant_spec: str | None, fault_texts: Se
     return Backend(bus=bus, tracker_port=testbed.tracker_port, virtual=testbed)
 
 
-def _drive_spec(config: TestbedConfig, axis: AxisConfig, free_length_mm: float):
+def _drive_spec(config: TestbedConfig, axis: AxisConfig):
     from sim_backend.drive.drive_spec import DriveSpec
 
     is_insertion = axis.kind == "insertion"
@@ -104,9 +110,9 @@ def _drive_spec(config: TestbedConfig, axis: AxisConfig, free_length_mm: float):
         homing_method=axis.homing_method, max_velocity_mm_s=axis.max_velocity_mm_s,
         max_acceleration_mm_s2=axis.max_acceleration_mm_s2, rated_torque_mnm=axis.rated_torque_mnm,
         following_error_window_mm=axis.following_error_window_mm, home_position_mm=axis.home_position_mm,
-        # the pulley block's negative limit switch sits at the home position; the catheter starts
-        # at its configured free length, the tendon shafts at zero
+        # the pulley block's negative limit switch sits at the home position, and the block starts
+        # just beyond it; the tendon shafts start at zero
         negative_limit_switch_mm=axis.home_position_mm if is_insertion else None,
-        start_position_mm=free_length_mm if is_insertion else 0.0,
+        start_position_mm=axis.home_position_mm + INSERTION_START_ABOVE_HOME_MM if is_insertion else 0.0,
         master_node_id=config.master.node_id, heartbeat_period_s=config.master.drive_heartbeat_period_s,
         heartbeat_timeout_s=config.master.heartbeat_timeout_s, cycle_period_s=config.sync.period_s)

@@ -7,11 +7,20 @@ from __future__ import annotations
 import argparse
 import sys
 
-from crest.cli import bench_command, demo_command, paper_command
+from crest.cli import (bench_command, demo_command, estop_command, home_command, jog_command, move_command,
+                       paper_command, run_command, status_command)
+from crest.config import ConfigError
+from crest.driver import SafetyStop
 from crest.exit_codes import ExitCode
 
 COMMANDS = {
     "demo": demo_command,
+    "status": status_command,
+    "home": home_command,
+    "move": move_command,
+    "run": run_command,
+    "jog": jog_command,
+    "estop": estop_command,
     "paper": paper_command,
     "bench": bench_command,
 }
@@ -31,9 +40,15 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         return int(args.handler(args))
+    except SafetyStop as stop:
+        print(f"crest: safety stop: {stop}", file=sys.stderr)
+        return int(stop.exit_code)
     except KeyboardInterrupt:
         print("crest: stopped by Ctrl-C", file=sys.stderr)
         return int(ExitCode.INTERRUPTED)
+    except ConfigError as exc:
+        print(f"crest: configuration error: {exc}", file=sys.stderr)
+        return int(ExitCode.CONFIG)
     except Exception as exc:  # the one place that turns any error into one line
         if args.debug:
             raise

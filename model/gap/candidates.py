@@ -17,6 +17,8 @@ removes more than the noise can explain (`is_meaningful`).
 """
 from __future__ import annotations
 
+import dataclasses
+import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
@@ -49,6 +51,7 @@ class CandidateResult:
     shrink: float
     signature_match: float
     score: float
+    seconds: float = 0.0
 
     @property
     def n_params(self) -> int:
@@ -65,7 +68,8 @@ class CandidateResult:
                 "n_params": self.n_params, "train_rmse_mm": number(self.fit.train_rmse_mm),
                 "holdout_rmse_mm": number(self.holdout_rmse_mm), "shrink": number(self.shrink),
                 "signature_match": self.signature_match, "score": number(self.score),
-                "diverged": not np.isfinite(self.holdout_rmse_mm), "flags": list(self.fit.flags)}
+                "diverged": not np.isfinite(self.holdout_rmse_mm), "flags": list(self.fit.flags),
+                "model_runs": self.fit.model_runs, "seconds": self.seconds}
 
 
 def start_values(effect_id: str) -> tuple[float, ...]:
@@ -128,6 +132,7 @@ def run_task(task: FitTask) -> CandidateResult:
       parameters (e.g. its tendon zeros bend the catheter at rest in place of precurvature),
       and the continuation can stall there.
     """
+    clock = time.perf_counter()
     fixed = dict(task.effects)
     last = list(fixed)[-1] if fixed else None
     train = task.prepared_train
@@ -144,7 +149,8 @@ def run_task(task: FitTask) -> CandidateResult:
     fit = calibrate(task.train, best.params, prior=task.prior, zero_offsets_mm=best.zero_offsets_mm,
                     effects=best.effects, resolution=task.resolution, max_iterations=task.iterations)
     errors = tuple(tip_errors(fit, task.holdout, task.resolution))
-    return evaluate(tuple(task.effects), fit, errors, task.baseline_errors, task.baseline_rmse_mm)
+    result = evaluate(tuple(task.effects), fit, errors, task.baseline_errors, task.baseline_rmse_mm)
+    return dataclasses.replace(result, seconds=time.perf_counter() - clock)
 
 
 def evaluate(effects: tuple[str, ...], fit: ModelFit, errors: Sequence[np.ndarray],

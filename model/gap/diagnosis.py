@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
@@ -86,7 +86,8 @@ def diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: Ca
     refit, singles = results[0], results[1:]
     if refit.fit.train_rmse_mm < baseline.train_rmse_mm:   # the control got further: it is the baseline
         baseline, base_errors, base_rmse = refit.fit, list(refit.holdout_errors), refit.holdout_rmse_mm
-        singles = [evaluate(r.effects, r.fit, r.holdout_errors, base_errors, base_rmse) for r in singles]
+        singles = [replace(evaluate(r.effects, r.fit, r.holdout_errors, base_errors, base_rmse), seconds=r.seconds)
+                   for r in singles]
     singles = ranked(singles)
     timing["candidates"] = time.perf_counter() - clock - sum(timing.values())
 

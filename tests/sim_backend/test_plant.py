@@ -20,10 +20,13 @@ class NaNPlant:
         return np.full(3, np.nan), np.zeros(4)
 
 
-def test_default_plant_is_the_dahl_catheter_with_no_effects():
+def test_default_plant_is_the_dahl_catheter_with_no_effects_and_10_to_20_percent_mismatch():
     config = PlantConfig.from_toml()
+    model = CatheterParams.from_toml()
     assert config.effects == {}
-    assert config.params == CatheterParams.from_toml()
+    assert config.params.mu == pytest.approx(1.15 * model.mu)
+    assert config.params.bending_stiffness_nmm2 == pytest.approx(0.9 * model.bending_stiffness_nmm2)
+    assert config.params.tendon_offset_mm == model.tendon_offset_mm
 
 
 def test_default_plant_bends_toward_pulled_tendon_and_reports_tension():

@@ -1,0 +1,63 @@
+"""`crest move --pitch DEG --yaw DEG --insertion MM`: a point move through the kinematics."""
+from __future__ import annotations
+
+import argparse
+import math
+
+import numpy as np
+
+from control import Articulation, articulation_from_pitch_yaw, make_controller
+from control.trajectories import point_to_point
+from crest.cli.common_options import (add_controller_options, add_record_option, add_testbed_options,
+                                      catheter_params, record_path, session_options)
+from crest.config import load_testbed_config
+from crest.experiment.controlled_run import run_with_controller
+from crest.experiment.recorder import ExperimentRecorder
+from crest.experiment.workspace_from_config import limits_for, workspace_for
+from crest.session import open_session
+
+MOVE_SPEED_FRACTION = 0.5
+
+
+def add_parser(sub) -> None:
+    parser = sub.add_parser("move", help="move the tip to a pitch, yaw and insertion")
+    parser.add_argument("--pitch", type=float, required=True, metavar="DEG", help="bend toward +x (tendon 1)")
+    parser.add_argument("--yaw", type=float, required=True, metavar="DEG", help="bend toward +y (tendon 2)")
+    parser.add_argument("--insertion", type=float, default=None, metavar="MM",
+                        help="free length out of the support tube (default: stay at home)")
+    add_controller_options(parser)
+    add_record_option(parser)
+    add_testbed_options(parser)
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    config = load_testbed_config(args.config)
+    params = catheter_params(args)
+    workspace, limits = workspace_for(config, params), limits_for(config)
+    start = Articulation(0.0, 0.0, config.insertion_axis.home_position_mm)
+    insertion = args.insertion if args.insertion is not None else start.insertion_mm
+    target = articulation_from_pitch_yaw(math.radians(args.pitch), math.radians(args.yaw), insertion)
+    trajectory = point_to_point(workspace, limits, waypoints=[target],          # refused before motion
+                                tendon_velocity_mm_s=MOVE_SPEED_FRACTION * limits.tendon_velocity_mm_s,
+                                tendon_acceleration_mm_s2=MOVE_SPEED_FRACTION * limits.tendon_acceleration_mm_s2,
+                                period_s=config.sync.period_s, start=start)
+    controller = make_controller(args.controller, workspace, limits, config.sync.period_s,
+                                 loss_timeout_s=config.tracker.loss_timeout_s)
+    with open_session(session_options(args)) as session:
+        session.testbed.home()
+        path = record_path(args.record, "move")
+        recorder = ExperimentRecorder(session, path, params, source=f"move with {args.controller}") if path else None
+        result = run_with_controller(session, trajectory, controller, recorder=recorder,
+                                     closed_loop=args.controller == "dahl+fb")
+        tip = session.tracker.latest() if session.tracker else None
+        if recorder:
+            recorder.close()
+    goal = trajectory.tip_mm[-1]
+    print(f"target tip  {np.array2string(goal, precision=2)} mm")
+    if tip is not None and tip.tip_mm is not None:
+        print(f"tracked tip {np.array2string(np.asarray(tip.tip_mm), precision=2)} mm, "
+              f"{np.linalg.norm(tip.tip_mm - goal):.2f} mm from the target")
+    if recorder:
+        print(f"log: {recorder.path}")
+    return 0

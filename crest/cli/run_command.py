@@ -1,0 +1,100 @@
+"""`crest run TRAJECTORY`: a builtin paper scenario or a set-point CSV, with a progress bar."""
+from __future__ import annotations
+
+import argparse
+import sys
+
+from control import Articulation, make_controller
+from crest.cli.common_options import (add_controller_options, add_record_option, add_testbed_options,
+                                      catheter_params, record_path, session_options)
+from crest.cli.progress import ProgressBar
+from crest.config import load_testbed_config
+from crest.driver.motion_limits import check_trajectory
+from crest.experiment.builtin_trajectories import BUILTINS, BuiltinOptions, builtin_trajectory
+from crest.experiment.controlled_run import run_with_controller
+from crest.experiment.recorder import ExperimentRecorder
+from crest.experiment.setpoint_csv import read_setpoints
+from crest.experiment.workspace_from_config import limits_for, workspace_for
+from crest.session import open_session
+
+
+def add_parser(sub) -> None:
+    parser = sub.add_parser("run", help="run a trajectory: builtin:sweep|circle|insertion|history or a set-point CSV")
+    parser.add_argument("trajectory", help="builtin:NAME or a CSV with t, tendon_cmd_1..4, insertion_cmd")
+    parser.add_argument("--articulation-deg", type=float, default=90.0, help="builtin: articulation angle")
+    parser.add_argument("--plane-deg", type=float, default=0.0, help="builtin: bending plane (0 = toward tendon 1)")
+    parser.add_argument("--insertion-mm", type=float, default=None, help="builtin: free length to use or reach")
+    parser.add_argument("--periods", type=float, default=1.0, help="builtin: sweeps or circle turns")
+    add_controller_options(parser)
+    add_record_option(parser)
+    add_testbed_options(parser)
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    config = load_testbed_config(args.config)
+    if args.trajectory.startswith("builtin:"):
+        return _run_builtin(args, config)
+    return _run_csv(args, config)
+
+
+def _run_builtin(args, config) -> int:
+    name = args.trajectory.split(":", 1)[1]
+    if name not in BUILTINS:
+        raise ValueError(f"unknown trajectory {args.trajectory!r}; choose builtin:{', builtin:'.join(BUILTINS)} "
+                         "or a set-point CSV")
+    params = catheter_params(args)
+    workspace, limits = workspace_for(config, params), limits_for(config)
+    period_s = config.sync.period_s
+    start = Articulation(0.0, 0.0, config.insertion_axis.home_position_mm)
+    options = BuiltinOptions(args.articulation_deg, args.plane_deg, args.insertion_mm, args.periods)
+    trajectory = builtin_trajectory(name, workspace, limits, options, period_s, start)   # refused before motion
+    controller = make_controller(args.controller, workspace, limits, period_s,
+                                 loss_timeout_s=config.tracker.loss_timeout_s)
+    with open_session(session_options(args)) as session:
+        session.testbed.home()
+        recorder = _recorder(session, args, params, f"builtin:{name} with {args.controller}")
+        progress = ProgressBar(len(trajectory), f"{args.trajectory} ({args.controller})")
+        result = run_with_controller(session, trajectory, controller, recorder=recorder,
+                                     closed_loop=args.controller == "dahl+fb", on_cycle=progress.update)
+        progress.finish()
+        if recorder:
+            recorder.close({"rms_tip_error_mm": result.rms_tip_error_mm})
+    _report(result)
+    return 0
+
+
+def _run_csv(args, config) -> int:
+    samples = read_setpoints(args.trajectory, config.sync.period_s)
+    check_trajectory(config, samples)                 # refused before anything moves
+    params = catheter_params(args)
+    with open_session(session_options(args)) as session:
+        session.testbed.home()
+        recorder = _recorder(session, args, params, f"set-points {args.trajectory}", tip_ref=False)
+        progress = ProgressBar(len(samples), args.trajectory)
+        done = [0]
+
+        def on_sample(sample):
+            done[0] += 1
+            tip = session.tracker.latest() if session.tracker else None
+            if recorder:
+                recorder.write(sample, tip.tip_mm if tip is not None else None)
+            progress.update(done[0])
+
+        session.testbed.run_trajectory(samples, on_sample=on_sample)
+        progress.finish()
+        if recorder:
+            recorder.close()
+    print(f"ran {len(samples)} set-points" + (f"; log: {recorder.path}" if recorder else ""))
+    return 0
+
+
+def _recorder(session, args, params, source, tip_ref=True):
+    path = record_path(args.record, "run")
+    return ExperimentRecorder(session, path, params, source=source, tip_ref=tip_ref) if path else None
+
+
+def _report(result) -> None:
+    rms = "no tip samples" if result.rms_tip_error_mm is None else f"RMS tip error {result.rms_tip_error_mm:.2f} mm"
+    print(f"ran {result.cycles} cycles; {rms}" + (f"; log: {result.log_path}" if result.log_path else ""),
+          file=sys.stdout)

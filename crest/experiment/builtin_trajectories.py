@@ -1,0 +1,62 @@
+"""The builtin trajectories of `crest run builtin:NAME`: the paper's scenarios."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from control import Articulation, MotionLimits, Workspace
+from control.trajectories import (Trajectory, articulation_sweep, circle, history_scenario,
+                                  insertion_at_articulation)
+
+BUILTINS = ("sweep", "circle", "insertion", "history")
+ARTICULATION_VELOCITY_RAD_S = 0.6
+ARTICULATION_ACCELERATION_RAD_S2 = 2.0
+INSERTION_VELOCITY_MM_S = 5.0
+INSERTION_ACCELERATION_MM_S2 = 20.0
+
+
+@dataclass(frozen=True)
+class BuiltinOptions:
+    articulation_deg: float = 90.0
+    plane_deg: float = 0.0
+    insertion_mm: float | None = None    # target free length (insertion) or circle's free length
+    periods: float = 1.0                 # sweeps, circle turns
+    circle_period_s: float = 8.0
+
+
+def builtin_trajectory(name: str, workspace: Workspace, limits: MotionLimits, options: BuiltinOptions,
+                       period_s: float, start: Articulation) -> Trajectory:
+    """The trajectory `name` from `start`; bad options raise TrajectoryError before anything moves."""
+    theta = math.radians(options.articulation_deg)
+    plane = math.radians(options.plane_deg)
+    common = dict(period_s=period_s, start=start)
+    if name == "sweep":   # to the articulation and back, `periods` times (each ends where it began)
+        one = articulation_sweep(workspace, limits, angle_rad=theta, plane_rad=plane,
+                                 velocity_rad_s=ARTICULATION_VELOCITY_RAD_S,
+                                 acceleration_rad_s2=ARTICULATION_ACCELERATION_RAD_S2, hold_s=0.5, back=True,
+                                 **common)
+        repeats = max(1, round(options.periods))
+        labels = [f"{label} {k + 1}" for k in range(repeats) for label in one.labels]
+        return Trajectory(np.tile(one.bend_rad, (repeats, 1)), np.tile(one.insertion_mm, repeats), labels,
+                          start, workspace, limits, period_s)
+    if name == "circle":
+        return circle(workspace, limits, articulation_rad=theta, circle_period_s=options.circle_period_s,
+                      turns=options.periods, start_plane_rad=plane, insertion_mm=options.insertion_mm,
+                      lead_in_velocity_rad_s=ARTICULATION_VELOCITY_RAD_S,
+                      lead_in_acceleration_rad_s2=ARTICULATION_ACCELERATION_RAD_S2, **common)
+    if name == "insertion":
+        target = options.insertion_mm if options.insertion_mm is not None else start.insertion_mm + 20.0
+        return insertion_at_articulation(workspace, limits, articulation_rad=theta, plane_rad=plane,
+                                         insertion_to_mm=target, insertion_velocity_mm_s=INSERTION_VELOCITY_MM_S,
+                                         insertion_acceleration_mm_s2=INSERTION_ACCELERATION_MM_S2,
+                                         articulation_velocity_rad_s=ARTICULATION_VELOCITY_RAD_S,
+                                         articulation_acceleration_rad_s2=ARTICULATION_ACCELERATION_RAD_S2,
+                                         **common)
+    if name == "history":
+        return history_scenario(workspace, limits, articulation_rad=theta, plane_rad=plane,
+                                velocity_rad_s=ARTICULATION_VELOCITY_RAD_S,
+                                acceleration_rad_s2=ARTICULATION_ACCELERATION_RAD_S2, **common)
+    raise ValueError(f"unknown builtin trajectory 'builtin:{name}'; choose one of "
+                     + ", ".join(f"builtin:{n}" for n in BUILTINS))

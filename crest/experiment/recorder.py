@@ -1,0 +1,69 @@
+"""Recording one experiment: the crest log (CSV + sidecar) and the CAN traffic beside it.
+
+The log is closed with the stop cause when a safety stop happens, so a stopped run leaves a
+complete, readable log.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from crest import __version__
+from crest.driver import CycleSample, SafetyStop
+from crest.log import BusRecorder, LogWriter
+from crest.log.log_format import catheter_dict
+from crest.session import Session
+from model import CatheterParams
+
+
+class ExperimentRecorder:
+    """Writes one row per SYNC cycle to `<path>.csv` and the bus to `<path>.blf`."""
+
+    def __init__(self, session: Session, csv_path: Path, catheter: CatheterParams, *, source: str,
+                 notes: str = "", tip_ref: bool = True):
+        csv_path = Path(csv_path)
+        csv_path.parent.mkdir(parents=True, exist_ok=True)
+        config = session.config
+        self.writer = LogWriter(
+            csv_path, catheter=catheter_dict(flexible_length_mm=catheter.max_free_length_mm,
+                                             tendon_offset_mm=catheter.tendon_offset_mm,
+                                             outer_diameter_mm=catheter.outer_diameter_mm),
+            sample_rate_hz=1.0 / config.sync.period_s, tendon_force=True, tip_ref=tip_ref,
+            source=f"crest {__version__}, {'virtual testbed' if session.backend.is_virtual else 'hardware'}: {source}",
+            notes=notes, config=config.as_dict())
+        self.bus_log_path = csv_path.with_suffix(".blf")
+        self.bus = BusRecorder(self.bus_log_path)
+        monitor = session.backend.monitor_bus()
+        if monitor is not None:
+            self.bus.listen(monitor)
+            self._monitor = monitor
+        else:
+            self._monitor = None
+            session.testbed.add_listener(self.bus)
+        session.testbed.on_safety_stop(self._on_safety_stop)
+        self._t0_s: float | None = None
+        self.closed = False
+
+    @property
+    def path(self) -> Path:
+        return self.writer.path
+
+    def write(self, sample: CycleSample, tip_mm: np.ndarray | None, tip_ref_mm: np.ndarray | None = None) -> None:
+        if self._t0_s is None:
+            self._t0_s = sample.t_s
+        self.writer.write(sample.t_s - self._t0_s, sample.tendon_target_mm, sample.insertion_target_mm,
+                          sample.tendon_position_mm, sample.insertion_position_mm, tip_mm,
+                          tendon_force_n=sample.tendon_tension_n, tip_ref_mm=tip_ref_mm)
+
+    def close(self, summary: dict | None = None) -> None:
+        if self.closed:
+            return
+        self.closed = True
+        self.writer.close(summary or {})
+        self.bus.close()
+        if self._monitor is not None:
+            self._monitor.shutdown()
+
+    def _on_safety_stop(self, stop: SafetyStop) -> None:
+        self.close({"stop_cause": str(stop), "exit_code": int(stop.exit_code)})

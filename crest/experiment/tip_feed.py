@@ -1,0 +1,44 @@
+"""Tip samples from the tracker, stamped on the control loop's clock.
+
+The tracker driver stamps samples with the host's monotonic clock; the loop may run on
+simulated time. A sample is taken as new when its frame number changes, and is stamped with
+the loop time at which it was first seen, so both clocks agree (tracker latency is below one
+cycle of the 40 Hz tracker). `age_s` is the loop time since the last valid tip.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from control import TipMeasurement
+from crest.tracker import AuroraDriver
+
+
+class TipFeed:
+    def __init__(self, tracker: AuroraDriver | None):
+        self.tracker = tracker
+        self._frame: int | None = None
+        self._last_valid_s: float | None = None
+        self._now_s = 0.0
+        self.latest_tip_mm: np.ndarray | None = None
+
+    def poll(self, now_s: float) -> TipMeasurement | None:
+        """The newest tip as a measurement, or None (no tracker, no new frame, or tool missing)."""
+        self._now_s = now_s
+        if self.tracker is None:
+            return None
+        sample = self.tracker.latest()
+        if sample is None or sample.frame == self._frame:
+            return None
+        self._frame = sample.frame
+        if sample.tip_mm is None:
+            self.latest_tip_mm = None
+            return None
+        self.latest_tip_mm = np.asarray(sample.tip_mm, dtype=float)
+        self._last_valid_s = now_s
+        return TipMeasurement(self.latest_tip_mm, now_s)
+
+    def age_s(self) -> float:
+        """Loop time since the last valid tip (inf before the first)."""
+        return math.inf if self._last_valid_s is None else self._now_s - self._last_valid_s

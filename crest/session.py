@@ -1,0 +1,66 @@
+"""One operator session: the testbed a configuration names, booted, with its tip tracker.
+
+`open_session` is what every CLI command and experiment uses. Leaving it by any route (normal
+end, Ctrl-C, an exception, a safety stop) leaves every axis stopped and the bus closed.
+"""
+from __future__ import annotations
+
+from collections.abc import Iterator, Sequence
+from contextlib import ExitStack, contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+from crest.backend import Backend, open_backend
+from crest.config import TestbedConfig, load_testbed_config
+from crest.driver import MonotonicClock, SteppedClock, Testbed
+from crest.tracker import AuroraDriver
+
+TRACKER_RATE_HZ = 40.0
+
+
+@dataclass
+class Session:
+    config: TestbedConfig
+    backend: Backend
+    testbed: Testbed
+    tracker: AuroraDriver | None
+
+
+@dataclass(frozen=True)
+class SessionOptions:
+    """What to open. plant/faults/effects apply to the virtual testbed only.
+
+    realtime=False runs the virtual testbed in simulated time (deterministic tests).
+    """
+
+    config_path: Path | None = None
+    plant: str | None = None
+    faults: Sequence[str] = ()
+    effects: dict | None = None
+    realtime: bool = True
+    boot: bool = True
+    tracker: bool = True
+    tracker_rate_hz: float = TRACKER_RATE_HZ
+
+
+@contextmanager
+def open_session(options: SessionOptions = SessionOptions()) -> Iterator[Session]:
+    config = load_testbed_config(options.config_path)
+    backend = open_backend(config, plant=options.plant, faults=options.faults, effects=options.effects,
+                           realtime=options.realtime)
+    with ExitStack() as stack:
+        stack.callback(backend.close)
+        clock = MonotonicClock() if options.realtime else SteppedClock(on_advance=backend.tick)
+        testbed = Testbed(backend.bus, config, clock=clock)
+        tracker = None
+        if options.tracker:
+            tracker = AuroraDriver(backend.tracker_port, baudrate=config.tracker.baudrate,
+                                   tool_port=config.tracker.tool_port, rate_hz=options.tracker_rate_hz)
+            tracker.start()
+            stack.callback(tracker.stop)
+        with testbed:
+            if options.boot:
+                testbed.boot()
+            else:
+                testbed.connect()
+            yield Session(config, backend, testbed, tracker)

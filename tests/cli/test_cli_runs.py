@@ -1,0 +1,127 @@
+"""The CLI on the virtual testbed, end to end: demo, runs, safety stops and their exit codes."""
+import json
+import signal
+import subprocess
+import time
+import warnings
+
+import can
+import pytest
+
+from cli_runner import crest, start_crest
+from crest.exit_codes import ExitCode
+from crest.log import read_log
+from crest.log.log_format import TruncatedLogWarning
+
+
+def test_demo_boots_homes_runs_the_paper_circle_and_records(tmp_path):
+    result = crest("demo", "--fast", "--record", str(tmp_path))
+    assert result.returncode == 0, result.stderr
+    assert "booted 5 axes" in result.stdout and "homed" in result.stdout
+    logs = sorted(tmp_path.glob("demo-*/circle-*.csv"))
+    assert [log.stem for log in logs] == ["circle-cc", "circle-dahl"]
+    for path in logs:
+        log = read_log(path)
+        assert len(log) > 1000 and log.tip_ref_mm is not None and log.tendon_force_n is not None
+        assert path.with_suffix(".blf").stat().st_size > 0
+        frames = list(can.LogReader(path.with_suffix(".blf")))
+        assert any(frame.arbitration_id == 0x80 for frame in frames)      # SYNC was recorded
+
+
+@pytest.mark.parametrize("fault,code,axis", [
+    ("tendon3:emcy@3.0", ExitCode.EMCY, "tendon3"),
+    ("insertion:heartbeat@3.0", ExitCode.HEARTBEAT_LOST, "insertion"),
+    ("tendon1:stall@1.5", ExitCode.FOLLOWING_ERROR, "tendon1"),   # jammed while pulling
+])
+def test_a_drive_fault_stops_every_axis_with_its_exit_code_and_keeps_the_log(tmp_path, fault, code, axis):
+    log_path = tmp_path / "run.csv"
+    result = crest("run", "builtin:sweep", "--articulation-deg", "90", "--fast", "--fault", fault,
+                   "--record", str(log_path))
+    assert result.returncode == code, result.stderr
+    lines = [line for line in result.stderr.splitlines() if line.startswith("crest:")]
+    assert len(lines) == 1 and axis in lines[0] and "Traceback" not in result.stderr
+    log = read_log(log_path)
+    assert len(log) > 50
+    sidecar = json.loads(log_path.with_suffix(".json").read_text())
+    assert axis in sidecar["summary"]["stop_cause"]
+
+
+def test_tracker_loss_in_a_closed_loop_run_stops_safely(tmp_path):
+    log_path = tmp_path / "run.csv"
+    result = crest("run", "builtin:sweep", "--controller", "dahl+fb", "--fast",
+                   "--fault", "tracker:disconnect@3.0", "--record", str(log_path))
+    assert result.returncode == ExitCode.TRACKER_LOST, result.stderr
+    assert "tracker" in result.stderr
+    assert len(read_log(log_path)) > 50
+
+
+def test_target_outside_the_workspace_is_refused_before_anything_moves():
+    result = crest("move", "--pitch", "400", "--yaw", "0")
+    assert result.returncode == ExitCode.ERROR
+    assert "booted" not in result.stdout
+    assert "crest: error:" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_nan_target_is_refused():
+    result = crest("move", "--pitch", "nan", "--yaw", "0")
+    assert result.returncode == ExitCode.ERROR
+    assert "finite" in result.stderr
+
+
+def test_too_fast_setpoint_file_is_refused_before_anything_moves(tmp_path):
+    path = tmp_path / "fast.csv"
+    path.write_text("t,tendon_cmd_1,tendon_cmd_2,tendon_cmd_3,tendon_cmd_4,insertion_cmd\n"
+                    "0,0,0,0,0,22\n0.01,5,0,-5,0,22\n")
+    result = crest("run", str(path), "--fast")
+    assert result.returncode == ExitCode.ERROR
+    assert "tendon1" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_bad_configuration_names_the_file_and_field(tmp_path):
+    from crest.config import default_config_path
+    text = default_config_path().read_text().replace("period_s = 0.01", "period_s = -1.0")
+    bad = tmp_path / "testbed.toml"
+    bad.write_text(text)
+    (tmp_path / "crest_drive.eds").write_text((default_config_path().parent / "crest_drive.eds").read_text())
+    result = crest("status", "--config", str(bad))
+    assert result.returncode == ExitCode.CONFIG
+    assert "sync.period_s" in result.stderr and str(bad) in result.stderr
+
+
+def test_bad_command_line_arguments_exit_with_usage():
+    result = crest("move", "--pitch", "ten", "--yaw", "0")
+    assert result.returncode == ExitCode.USAGE
+    assert "invalid float value" in result.stderr
+
+
+def test_ctrl_c_stops_every_axis_and_saves_the_log(tmp_path):
+    log_path = tmp_path / "run.csv"
+    process = start_crest("run", "builtin:circle", "--record", str(log_path), stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while not log_path.exists() or log_path.stat().st_size < 2000:
+        assert time.monotonic() < deadline and process.poll() is None
+        time.sleep(0.1)
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == ExitCode.INTERRUPTED, stderr
+    assert "Ctrl-C" in stderr
+    sidecar = json.loads(log_path.with_suffix(".json").read_text())
+    assert "stop_cause" in sidecar["summary"]
+    assert len(read_log(log_path)) > 10
+
+
+def test_killed_process_leaves_a_readable_log(tmp_path):
+    log_path = tmp_path / "run.csv"
+    process = start_crest("run", "builtin:circle", "--record", str(log_path))
+    deadline = time.monotonic() + 60
+    while not log_path.exists() or log_path.stat().st_size < 5000:
+        assert time.monotonic() < deadline and process.poll() is None
+        time.sleep(0.1)
+    time.sleep(1.5)                    # 150 more cycles at 100 Hz: at least 100 of them are flushed
+    process.kill()                     # SIGKILL: no handler runs, nothing is flushed at exit
+    process.wait(timeout=30)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TruncatedLogWarning)   # a partly written last line is allowed
+        log = read_log(log_path)
+    assert len(log) >= 150
