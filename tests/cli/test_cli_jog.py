@@ -29,11 +29,11 @@ def test_jog_moves_pitch_and_insertion_and_releases_on_quit(tmp_path):
                                stdin=slave, stdout=slave, stderr=slave, close_fds=True)
     os.close(slave)
     try:
-        read_until(master, b"pitch", timeout_s=60)          # homed; the live status line is up
+        read_until(master, b"L  20.0 mm", timeout_s=60)     # homed at 20 mm free length; status line is up
         os.write(master, b"sss")                              # pitch +6 deg
         read_until(master, b"pitch   +6.0 deg", timeout_s=30)
         os.write(master, b"rr")                               # 2 mm more free length
-        out = read_until(master, b"L  24.0 mm", timeout_s=30)
+        out = read_until(master, b"L  22.0 mm", timeout_s=30)
         os.write(master, b"q")
         out += read_until(master, b"released", timeout_s=60)
         assert process.wait(timeout=60) == 0
