@@ -34,6 +34,7 @@ class SessionOptions:
     """
 
     config_path: Path | None = None
+    config: TestbedConfig | None = None     # an already loaded configuration (overrides config_path)
     plant: str | None = None
     faults: Sequence[str] = ()
     effects: dict | None = None
@@ -45,7 +46,7 @@ class SessionOptions:
 
 @contextmanager
 def open_session(options: SessionOptions = SessionOptions()) -> Iterator[Session]:
-    config = load_testbed_config(options.config_path)
+    config = options.config if options.config is not None else load_testbed_config(options.config_path)
     backend = open_backend(config, plant=options.plant, faults=options.faults, effects=options.effects,
                            realtime=options.realtime)
     with ExitStack() as stack:

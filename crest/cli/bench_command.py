@@ -6,7 +6,8 @@ import json
 import sys
 from pathlib import Path
 
-from crest.bench import model_bench
+from control.benchmark import controller_cycle_times
+from crest.bench import model_bench, stack_bench
 from crest.bench.machine_info import machine_info
 from model import CatheterParams
 
@@ -30,6 +31,9 @@ def run(args: argparse.Namespace) -> int:
         "model": lambda: model_bench.model_step(params),
         "scaling": lambda: model_bench.scaling_in_n(params),
         "move": lambda: model_bench.quasi_static_move(params),
+        "controllers": lambda: controller_cycle_times(params),
+        "full_stack": lambda: {f"{rate:.0f}_hz": stack_bench.full_stack(rate, args.stack_seconds)
+                               for rate in (500.0, 250.0)},
     }
     for name in args.only:
         if name not in steps:
@@ -55,6 +59,16 @@ def format_table(results: dict) -> str:
                      r["cost_exponent"] <= r["goal_cost_exponent"]))
     if "move" in results:
         rows.append(("move_to 0 -> 180 deg", f"{results['move']['wall_ms']:.1f} ms", "-", None))
+    for name, r in results.get("controllers", {}).items():
+        rows.append((f"Controller {name}, per cycle", f"median {r['median_us']:.0f} us, p99 {r['p99_us']:.0f} us",
+                     "well inside 10 ms", r["p99_us"] < 5000))
+    for key, r in results.get("full_stack", {}).items():
+        rows.append((f"Full stack at {r['sync_rate_hz_nominal']:.0f} Hz SYNC, {r['duration_s']:.0f} s",
+                     f"{r['achieved_rate_hz']:.0f} Hz, jitter p50 {r['jitter_p50_ms']:.2f} / p99 "
+                     f"{r['jitter_p99_ms']:.2f} ms, {r['missed_cycles']} missed, bus load "
+                     f"{100 * r['bus_load_mean']:.0f}% of {r['bus_bitrate_bit_s'] / 1e6:g} Mbit/s",
+                     "rate held, 0 missed, p99 <= 1 ms",
+                     r["missed_cycles"] == 0 and r["jitter_p99_ms"] <= 1.0))
     lines = ["| measure | result | goal | met |", "|---|---|---|---|"]
     for name, value, goal, met in rows:
         lines.append(f"| {name} | {value} | {goal} | {'-' if met is None else ('yes' if met else 'NO')} |")
