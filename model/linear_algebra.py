@@ -31,13 +31,7 @@ def solve_in_place(a, b, n: int, m: int) -> bool:
                     a[row, j] -= factor * a[col, j]
                 for j in range(m):
                     b[row, j] -= factor * b[col, j]
-    for col in range(n - 1, -1, -1):
-        inv = 1.0 / a[col, col]
-        for j in range(m):
-            acc = b[col, j]
-            for k in range(col + 1, n):
-                acc -= a[col, k] * b[k, j]
-            b[col, j] = acc * inv
+    _back_substitute(a, b, n, m)
     return True
 
 
@@ -56,6 +50,12 @@ def solve_diagonally_dominant(a, b, n: int, m: int) -> None:
                 a[row, j] -= factor * a[col, j]
             for j in range(m):
                 b[row, j] -= factor * b[col, j]
+    _back_substitute(a, b, n, m)
+
+
+@kernel
+def _back_substitute(a, b, n: int, m: int) -> None:
+    """X from the upper triangle of A (after elimination): b holds X on return."""
     for col in range(n - 1, -1, -1):
         inv = 1.0 / a[col, col]
         for j in range(m):

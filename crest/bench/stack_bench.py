@@ -7,7 +7,6 @@ longer than 1.5 nominal periods) and the bus load the traffic would put on a rea
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import can
 import numpy as np

@@ -5,7 +5,11 @@ import argparse
 from datetime import datetime
 from pathlib import Path
 
-from control import CONTROLLER_NAMES
+from dataclasses import dataclass
+
+from control import CONTROLLER_NAMES, Articulation, MotionLimits, Workspace
+from crest.config import TestbedConfig, load_testbed_config
+from crest.experiment.workspace_from_config import limits_for, workspace_for
 from crest.session import SessionOptions
 from model import CatheterParams
 
@@ -72,3 +76,22 @@ def record_path(record: Path | None, stem: str) -> Path | None:
     if record.suffix.lower() == ".csv":
         return record
     return record / f"{stem}-{datetime.now().strftime('%Y%m%d-%H%M%S')}.csv"
+
+
+@dataclass(frozen=True)
+class MotionPlan:
+    """What a motion command plans with, before anything is opened or moves."""
+
+    config: TestbedConfig
+    params: CatheterParams
+    workspace: Workspace
+    limits: MotionLimits
+    period_s: float
+    start: Articulation        # where the catheter rests after homing
+
+
+def motion_plan(args: argparse.Namespace) -> MotionPlan:
+    config = load_testbed_config(args.config)
+    params = catheter_params(args)
+    return MotionPlan(config, params, workspace_for(config, params), limits_for(config), config.sync.period_s,
+                      Articulation(0.0, 0.0, config.insertion_axis.home_position_mm))

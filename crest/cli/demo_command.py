@@ -10,14 +10,12 @@ import argparse
 import time
 from pathlib import Path
 
-from control import Articulation, make_controller
-from crest.cli.common_options import add_testbed_options, catheter_params, session_options
+from control import make_controller
+from crest.cli.common_options import add_testbed_options, motion_plan, session_options
 from crest.cli.progress import ProgressBar
-from crest.config import load_testbed_config
 from crest.experiment.builtin_trajectories import BuiltinOptions, builtin_trajectory
 from crest.experiment.controlled_run import run_with_controller
 from crest.experiment.recorder import ExperimentRecorder
-from crest.experiment.workspace_from_config import limits_for, workspace_for
 from crest.session import open_session
 
 DEMO_ARTICULATION_DEG = 120.0
@@ -33,13 +31,10 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    config = load_testbed_config(args.config)
-    params = catheter_params(args)
-    workspace, limits = workspace_for(config, params), limits_for(config)
-    period_s = config.sync.period_s
-    start = Articulation(0.0, 0.0, config.insertion_axis.home_position_mm)
+    plan = motion_plan(args)
+    config, params, workspace, limits, period_s = plan.config, plan.params, plan.workspace, plan.limits, plan.period_s
     options = BuiltinOptions(articulation_deg=DEMO_ARTICULATION_DEG, insertion_mm=DEMO_INSERTION_MM)
-    trajectory = builtin_trajectory("circle", workspace, limits, options, period_s, start)
+    trajectory = builtin_trajectory("circle", workspace, limits, options, period_s, plan.start)
     out_dir = args.record / f"demo-{time.strftime('%Y%m%d-%H%M%S')}"
     results = {}
     with open_session(session_options(args)) as session:

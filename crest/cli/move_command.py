@@ -6,14 +6,12 @@ import math
 
 import numpy as np
 
-from control import Articulation, articulation_from_pitch_yaw, make_controller
+from control import articulation_from_pitch_yaw, make_controller
 from control.trajectories import point_to_point
-from crest.cli.common_options import (add_controller_options, add_record_option, add_testbed_options,
-                                      catheter_params, record_path, session_options)
-from crest.config import load_testbed_config
+from crest.cli.common_options import (add_controller_options, add_record_option, add_testbed_options, motion_plan,
+                                      record_path, session_options)
 from crest.experiment.controlled_run import run_with_controller
 from crest.experiment.recorder import ExperimentRecorder
-from crest.experiment.workspace_from_config import limits_for, workspace_for
 from crest.session import open_session
 
 MOVE_SPEED_FRACTION = 0.5
@@ -32,10 +30,8 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    config = load_testbed_config(args.config)
-    params = catheter_params(args)
-    workspace, limits = workspace_for(config, params), limits_for(config)
-    start = Articulation(0.0, 0.0, config.insertion_axis.home_position_mm)
+    plan = motion_plan(args)
+    config, params, workspace, limits, start = plan.config, plan.params, plan.workspace, plan.limits, plan.start
     insertion = args.insertion if args.insertion is not None else start.insertion_mm
     target = articulation_from_pitch_yaw(math.radians(args.pitch), math.radians(args.yaw), insertion)
     trajectory = point_to_point(workspace, limits, waypoints=[target],          # refused before motion
@@ -48,8 +44,8 @@ def run(args: argparse.Namespace) -> int:
         session.testbed.home()
         path = record_path(args.record, "move")
         recorder = ExperimentRecorder(session, path, params, source=f"move with {args.controller}") if path else None
-        result = run_with_controller(session, trajectory, controller, recorder=recorder,
-                                     closed_loop=args.controller == "dahl+fb")
+        run_with_controller(session, trajectory, controller, recorder=recorder,
+                            closed_loop=args.controller == "dahl+fb")
         tip = session.tracker.latest() if session.tracker else None
         if recorder:
             recorder.close()

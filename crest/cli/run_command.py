@@ -4,9 +4,9 @@ from __future__ import annotations
 import argparse
 import sys
 
-from control import Articulation, make_controller
+from control import make_controller
 from crest.cli.common_options import (add_controller_options, add_record_option, add_testbed_options,
-                                      catheter_params, record_path, session_options)
+                                      catheter_params, motion_plan, record_path, session_options)
 from crest.cli.progress import ProgressBar
 from crest.config import load_testbed_config
 from crest.driver.motion_limits import check_trajectory
@@ -14,7 +14,6 @@ from crest.experiment.builtin_trajectories import BUILTINS, BuiltinOptions, buil
 from crest.experiment.controlled_run import run_with_controller
 from crest.experiment.recorder import ExperimentRecorder
 from crest.experiment.setpoint_csv import read_setpoints
-from crest.experiment.workspace_from_config import limits_for, workspace_for
 from crest.session import open_session
 
 
@@ -43,12 +42,10 @@ def _run_builtin(args, config) -> int:
     if name not in BUILTINS:
         raise ValueError(f"unknown trajectory {args.trajectory!r}; choose builtin:{', builtin:'.join(BUILTINS)} "
                          "or a set-point CSV")
-    params = catheter_params(args)
-    workspace, limits = workspace_for(config, params), limits_for(config)
-    period_s = config.sync.period_s
-    start = Articulation(0.0, 0.0, config.insertion_axis.home_position_mm)
+    plan = motion_plan(args)
+    params, workspace, limits, period_s = plan.params, plan.workspace, plan.limits, plan.period_s
     options = BuiltinOptions(args.articulation_deg, args.plane_deg, args.insertion_mm, args.periods)
-    trajectory = builtin_trajectory(name, workspace, limits, options, period_s, start)   # refused before motion
+    trajectory = builtin_trajectory(name, workspace, limits, options, period_s, plan.start)   # refused before motion
     controller = make_controller(args.controller, workspace, limits, period_s,
                                  loss_timeout_s=config.tracker.loss_timeout_s)
     with open_session(session_options(args)) as session:
