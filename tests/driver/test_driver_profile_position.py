@@ -17,7 +17,7 @@ def test_a_point_move_reaches_every_target_within_the_position_window(homed):
     reached = homed.testbed.positions()
     assert reached.values() == pytest.approx(targets.values(), abs=0.021)  # position window 0.02 mm + 1 count
     assert [homed.drive(name).position_actual_mm for name in ("tendon1", "insertion")] == pytest.approx(
-        [3.0 + 0.02, 35.0], abs=0.021)
+        [3.0 + homed.config.coordination.pretension_mm, 35.0], abs=0.021)
 
 
 def test_antagonistic_tendons_keep_the_pretension_all_the_way(homed):
@@ -68,7 +68,8 @@ def test_set_point_handshake_on_the_wire(homed):
             events.append(("tpdo", feedback[0]))
     rise = next(i for i, event in enumerate(events) if event[0] == "rpdo" and event[1] & 0x10)
     target_counts = events[rise][2]
-    assert target_counts == homed.config.axis("tendon1").mm_to_counts(1.02)
+    pretension_mm = homed.config.coordination.pretension_mm
+    assert target_counts == homed.config.axis("tendon1").mm_to_counts(1.0 + pretension_mm)
     earlier = [event for event in events[:rise] if event[0] == "rpdo"]
     assert earlier[-1][2] == target_counts and not earlier[-1][1] & 0x10   # target sent a cycle before bit 4
     assert not events[rise][1] & 0x0100                                     # halt released with the set-point
