@@ -18,6 +18,7 @@ trade off (e.g. EI and mu: friction is proportional to mu * tension and tension 
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -28,7 +29,7 @@ from model.dahl_catheter import ModelSolverError
 from model.effects.catalog import combined_terms, effect
 from model.gap.free_parameters import ParameterLayout
 from model.gap.recording import Recording
-from model.gap.simulation import Resolution, catheter_for, predict_tips
+from model.gap.simulation import Resolution, SimulationTooSlow, catheter_for, predict_tips
 from model.params import CatheterParams
 
 DIFF_STEP = 0.02       # relative finite-difference step: far above the kernel's ~1 um solver noise
@@ -40,6 +41,10 @@ MAX_RESTARTS = 2
 RESTART_GAIN = 0.01
 XTOL_REACHED = 3       # least_squares status
 DIVERGED_RESIDUAL_MM = 1e3
+# Where the solver crawls (e.g. very stiff Dahl friction), a run is abandoned and scored as diverged
+# once it takes SLOW_RUN_FACTOR times as long as the run at the start (and at least MIN_TIME_LIMIT_S).
+SLOW_RUN_FACTOR = 8.0
+MIN_TIME_LIMIT_S = 0.5
 
 
 @dataclass(frozen=True)
@@ -107,18 +112,20 @@ def rmse_mm(errors: Sequence[np.ndarray]) -> float:
     return float(np.sqrt(np.mean(np.sum(stacked ** 2, axis=1))))
 
 
-def tip_errors(fit: ModelFit, recordings: Sequence[Recording], resolution: Resolution) -> list[np.ndarray]:
+def tip_errors(fit: ModelFit, recordings: Sequence[Recording], resolution: Resolution,
+               time_limit_s: float | None = None) -> list[np.ndarray]:
     """Model minus measured tip [n_valid, 3] per recording (recordings already at the fit resolution).
 
-    Where the model diverges at these parameters the errors are infinite.
+    Where the model diverges at these parameters, or a recording's run exceeds time_limit_s,
+    the errors are infinite.
     """
     terms = fit.terms()
     zero = np.asarray(fit.zero_offsets_mm)
     errors = []
     for r in recordings:
         try:
-            tips = predict_tips(fit.params, terms, zero, r, resolution)
-        except ModelSolverError:
+            tips = predict_tips(fit.params, terms, zero, r, resolution, time_limit_s)
+        except (ModelSolverError, SimulationTooSlow):
             tips = np.full(r.tip_mm.shape, np.inf)
         error = (tips - r.tip_mm)[r.valid]
         error[~np.isfinite(error)] = np.inf
@@ -148,11 +155,16 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
     zero_start = np.asarray(zero_offsets_mm, dtype=float)
     runs = 0
     costs: list[float] = []
+    time_limit_s: float | None = None
 
     def residuals(z: np.ndarray) -> np.ndarray:
-        nonlocal runs
+        nonlocal runs, time_limit_s
         params, zero, values = layout.unpack(z, start, zero_start)
-        out = np.concatenate(tip_errors(ModelFit(params, tuple(zero), values), prepared, resolution)).ravel()
+        clock = time.perf_counter()
+        out = np.concatenate(tip_errors(ModelFit(params, tuple(zero), values), prepared, resolution,
+                                        time_limit_s)).ravel()
+        if time_limit_s is None:   # the first run, at the start: the yardstick for a normal run
+            time_limit_s = max(SLOW_RUN_FACTOR * (time.perf_counter() - clock), MIN_TIME_LIMIT_S)
         if not np.all(np.isfinite(out)):   # the solver failed at these parameters: make them unattractive
             out = np.full_like(out, DIVERGED_RESIDUAL_MM)
         runs += 1

@@ -6,6 +6,7 @@ straight, unloaded state at its first free length.
 """
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -17,6 +18,7 @@ from model.gap.recording import Recording, RecordingError
 from model.params import CatheterParams
 
 TENDON_RANGE_MARGIN_MM = 10.0
+CHUNK_SAMPLES = 200
 
 
 @dataclass(frozen=True)
@@ -73,11 +75,30 @@ def catheter_for(base: CatheterParams, recordings: Sequence[Recording]) -> Cathe
                         tendon_range_mm=(-reach, reach))
 
 
+class SimulationTooSlow(RuntimeError):
+    """A run exceeded its time limit: parameters where the quasi-static solver struggles."""
+
+
 def predict_tips(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray, recording: Recording,
-                 resolution: Resolution) -> np.ndarray:
-    """Model tips [T, 3] (mm) along the recording's measured inputs, from the straight state."""
+                 resolution: Resolution, time_limit_s: float | None = None) -> np.ndarray:
+    """Model tips [T, 3] (mm) along the recording's measured inputs, from the straight state.
+
+    With a time limit the path runs in chunks of CHUNK_SAMPLES and SimulationTooSlow is raised
+    once the limit is exceeded (fits use it to give up on parameters that make the solver crawl).
+    """
     model = _model(params, effects, recording, resolution)
-    return model.run(recording.tendon_mm - zero_offsets_mm, recording.insertion_mm, recording.sample_period_s)
+    u = recording.tendon_mm - zero_offsets_mm
+    dt_s = recording.sample_period_s
+    if time_limit_s is None:
+        return model.run(u, recording.insertion_mm, dt_s)
+    deadline = time.perf_counter() + time_limit_s
+    tips = np.empty((len(recording), 3))
+    for start in range(0, len(recording), CHUNK_SAMPLES):
+        stop = start + CHUNK_SAMPLES
+        tips[start:stop] = model.run(u[start:stop], recording.insertion_mm[start:stop], dt_s)
+        if time.perf_counter() > deadline:
+            raise SimulationTooSlow(f"{recording.name}: the model run exceeded {time_limit_s:.2f} s")
+    return tips
 
 
 def predict_tips_and_tension(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray,
