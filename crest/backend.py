@@ -53,16 +53,17 @@ class Backend:
 
 
 def open_backend(config: TestbedConfig, *, plant: str | None = None, faults: Sequence[str] = (),
-                 effects: dict | None = None, realtime: bool = True,
-                 plant_in_thread: bool = False) -> Backend:
+                 effects: dict | None = None, realtime: bool = True, plant_in_thread: bool = False,
+                 tracker_noise_mm: float | None = None, tracker_dropout: float | None = None) -> Backend:
     """Open the bus and tracker of `config`.
 
-    plant ('package.module:ClassName'), faults ('AXIS:KIND@SECONDS') and effects
-    ({effect id: {param: value}}, added to configs/virtual_plant.toml's) apply to the virtual
-    testbed only. realtime=False leaves time to the caller's `Backend.tick` (tests).
+    plant ('package.module:ClassName'), faults ('AXIS:KIND@SECONDS'), effects
+    ({effect id: {param: value}}, added to configs/virtual_plant.toml's) and the tracker's noise
+    and dropout apply to the virtual testbed only. realtime=False leaves time to the caller's
+    `Backend.tick` (tests).
     """
     if config.bus.interface != "virtual":
-        if plant or faults or effects:
+        if plant or faults or effects or tracker_noise_mm is not None or tracker_dropout is not None:
             raise BackendError("--plant, --fault and --effect need the virtual testbed; "
                                f"{config.path} selects the real bus '{config.bus.interface}'")
         if config.tracker.port == "sim":
@@ -74,11 +75,13 @@ def open_backend(config: TestbedConfig, *, plant: str | None = None, faults: Seq
             raise BackendError(f"cannot open CAN interface '{config.bus.interface}' channel "
                                f"'{config.bus.channel}': {exc}. Check the adapter and [bus] in {config.path}") from exc
         return Backend(bus=bus, tracker_port=config.tracker.port)
-    return _open_virtual(config, plant, faults, effects or {}, realtime, plant_in_thread)
+    return _open_virtual(config, plant, faults, effects or {}, realtime, plant_in_thread, tracker_noise_mm,
+                         tracker_dropout)
 
 
 def _open_virtual(config: TestbedConfig, plant_spec: str | None, fault_texts: Sequence[str], effects: dict,
-                  realtime: bool, plant_in_thread: bool) -> Backend:
+                  realtime: bool, plant_in_thread: bool, tracker_noise_mm: float | None,
+                  tracker_dropout: float | None) -> Backend:
     from sim_backend.faults import parse_fault
     from sim_backend.plant import DahlPlant, PlantConfig, load_plant
     from sim_backend.virtual_testbed import TrackerSettings, VirtualTestbed
@@ -91,8 +94,10 @@ def _open_virtual(config: TestbedConfig, plant_spec: str | None, fault_texts: Se
     channel = f"{config.bus.channel}-{os.getpid()}-{next(_channel_numbers)}"
     testbed = VirtualTestbed(specs, channel, plant, bitrate_bit_s=config.bus.bitrate,
                              sync_period_s=config.sync.period_s, faults=faults,
-                             tracker=TrackerSettings(plant_config.tracker_noise_mm, plant_config.tracker_dropout,
-                                                     plant_config.tracker_seed, int(config.tracker.tool_port, 16)),
+                             tracker=TrackerSettings(
+                                 plant_config.tracker_noise_mm if tracker_noise_mm is None else tracker_noise_mm,
+                                 plant_config.tracker_dropout if tracker_dropout is None else tracker_dropout,
+                                 plant_config.tracker_seed, int(config.tracker.tool_port, 16)),
                              plant_in_thread=plant_in_thread)
     testbed.start(realtime=realtime)
     bus = can.Bus(interface="virtual", channel=channel, receive_own_messages=False)

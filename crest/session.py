@@ -42,13 +42,16 @@ class SessionOptions:
     boot: bool = True
     tracker: bool = True
     tracker_rate_hz: float = TRACKER_RATE_HZ
+    tracker_noise_mm: float | None = None     # virtual tracker: overrides configs/virtual_plant.toml
+    tracker_dropout: float | None = None
 
 
 @contextmanager
 def open_session(options: SessionOptions = SessionOptions()) -> Iterator[Session]:
     config = options.config if options.config is not None else load_testbed_config(options.config_path)
     backend = open_backend(config, plant=options.plant, faults=options.faults, effects=options.effects,
-                           realtime=options.realtime)
+                           realtime=options.realtime, tracker_noise_mm=options.tracker_noise_mm,
+                           tracker_dropout=options.tracker_dropout)
     with ExitStack() as stack:
         stack.callback(backend.close)
         clock = MonotonicClock() if options.realtime else SteppedClock(on_advance=backend.tick)

@@ -7,8 +7,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from crest.cli import (bench_command, demo_command, estop_command, excite_command, home_command, jog_command,
-                       move_command, paper_command, run_command, status_command)
+from crest.cli import (bench_command, demo_command, estop_command, excite_command, fit_command, gap_command,
+                       home_command, jog_command, move_command, paper_command, run_command, status_command)
 from crest.config import ConfigError
 from crest.driver import SafetyStop
 from crest.exit_codes import ExitCode
@@ -24,6 +24,8 @@ COMMANDS = {
     "excite": excite_command,
     "paper": paper_command,
     "bench": bench_command,
+    "fit": fit_command,
+    "gap": gap_command,
 }
 
 

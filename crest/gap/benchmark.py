@@ -27,7 +27,7 @@ def diagnosis_time(duration_s: float = 600.0, sample_rate_hz: float = 100.0, wor
     """Seconds to diagnose a `duration_s` training log plus the standard held-out log, with the verdict."""
     params = CatheterParams.from_toml()
     geometry = ExcitationGeometry.from_params(params)
-    plant = Plant(params.replace(mu=0.25, bending_stiffness_nmm2=1000.0), {"backlash": (0.4,)})
+    plant = Plant(params.replace(mu=0.25), {"backlash": (0.4,)})
     rng = np.random.default_rng(seed)
     with tempfile.TemporaryDirectory(prefix="crest-gap-bench-") as folder:
         train = record_plant_log(Path(folder) / "train.csv",

@@ -2,13 +2,12 @@
 
 The plant is a fine DahlCatheter (20 elements) with its own base parameters, tendon zero
 offsets and any candidate effects switched on. The drives follow the set-points exactly and
-report them at encoder resolution; the tracker adds Gaussian noise and drops samples; the
-drive tension is reported with noise. The log records only what a testbed would: which
+report them; the tracker adds Gaussian noise and drops samples; the drive tension is reported
+with noise. The log records only what a testbed would: which
 effect the plant has is never written (the sidecar says "model plant", nothing more).
 """
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -19,12 +18,6 @@ from control.excitation import Trajectory
 from crest.log import LogWriter, catheter_dict
 from model import CatheterParams, DahlCatheter
 from model.effects import combined_terms
-
-# 4096 counts/rev, gear 10, 5 mm drum (configs/testbed.toml): tendon position resolution.
-TENDON_ENCODER_STEP_MM = 2 * math.pi * 5.0 / (4096 * 10.0)
-# 4096 counts/rev, gear 20, 8 mm pulley.
-INSERTION_ENCODER_STEP_MM = 2 * math.pi * 8.0 / (4096 * 20.0)
-
 
 @dataclass(frozen=True)
 class SensorNoise:
@@ -48,8 +41,8 @@ class Plant:
 def record_plant_log(path: Path | str, trajectory: Trajectory, plant: Plant, noise: SensorNoise,
                      rng: np.random.Generator, *, overwrite: bool = False) -> Path:
     """Drive the plant along the trajectory and write what the testbed would log; returns the CSV path."""
-    tendon_pos = np.round(trajectory.tendon_mm / TENDON_ENCODER_STEP_MM) * TENDON_ENCODER_STEP_MM
-    insertion_pos = np.round(trajectory.insertion_mm / INSERTION_ENCODER_STEP_MM) * INSERTION_ENCODER_STEP_MM
+    tendon_pos = trajectory.tendon_mm
+    insertion_pos = trajectory.insertion_mm
     params = plant.params.replace(free_length_mm=float(insertion_pos[0]))
     catheter = DahlCatheter(params, plant.n_elements, combined_terms(plant.effects))
     u = tendon_pos - np.asarray(plant.zero_offsets_mm)

@@ -44,7 +44,7 @@ DIVERGED_RESIDUAL_MM = 1e3
 # Where the solver crawls (e.g. very stiff Dahl friction), a run is abandoned and scored as diverged
 # once it takes SLOW_RUN_FACTOR times as long as the run at the start (and at least MIN_TIME_LIMIT_S).
 SLOW_RUN_FACTOR = 8.0
-MIN_TIME_LIMIT_S = 0.5
+MIN_TIME_LIMIT_S = 0.1
 
 
 @dataclass(frozen=True)
@@ -142,12 +142,12 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
 
     max_iterations bounds the cost evaluations of each least_squares run (not counting the
     Jacobian's); up to `restarts` restarts follow a collapsed trust region.
-    recordings: training recordings at full rate (decimated here to `resolution.fit_rate_hz`).
+    recordings: training recordings at full rate (decimated and capped here, Resolution.prepare_training).
     start: warm start; its geometry is replaced by the recordings'. prior: the catheter the
     physical ranges refer to (default: start). effects: {effect id: starting values}.
     Returns a new ModelFit; `start` is unchanged.
     """
-    prepared = resolution.prepare(recordings)
+    prepared = resolution.prepare_training(recordings)
     start = catheter_for(start, prepared)
     prior = catheter_for(prior or start, prepared)
     effects = {effect_id: tuple(values) for effect_id, values in (effects or {}).items()}

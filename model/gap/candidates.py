@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from model.effects.catalog import effect
-from model.gap.calibration import ModelFit, calibrate, rmse_mm, tip_errors
+from model.gap.calibration import MIN_TIME_LIMIT_S, SLOW_RUN_FACTOR, ModelFit, calibrate, rmse_mm, tip_errors
 from model.gap.recording import Recording
 from model.gap.simulation import Resolution, catheter_for
 from model.params import CatheterParams
@@ -38,7 +38,7 @@ MIN_SHRINK_WITHOUT_NOISE = 0.05   # ... or 5 % when the noise floor is unknown
 MIN_GAIN_OVER_NOISE = 0.1   # ... and at least 10 % of the noise variance 3 sigma^2 (mm^2)
 MIN_EXCESS_FRACTION = 0.25  # ... and a quarter of the squared error above the noise floor
 CANDIDATE_ITERATIONS = 15
-EXPLORE_ITERATIONS = 4       # cost evaluations of each start's exploratory fit
+EXPLORE_ITERATIONS = 3       # cost evaluations of each start's exploratory fit
 
 
 @dataclass(frozen=True)
@@ -120,7 +120,7 @@ class FitTask:
 
     @property
     def prepared_train(self) -> list[Recording]:
-        return self.resolution.prepare(self.train)
+        return self.resolution.prepare_training(self.train)
 
 
 def run_task(task: FitTask) -> CandidateResult:
@@ -140,8 +140,8 @@ def run_task(task: FitTask) -> CandidateResult:
     prior = ModelFit(catheter_for(task.prior, train), (0.0, 0.0, 0.0, 0.0), {})
     continuation = (task.start, {**fixed, last: start_values(last)} if last else {})
     fresh_starts = [{**fixed, last: probe} if last else {} for probe in (probe_values(last) if last else [()])]
-    costs = [rmse_mm(tip_errors(ModelFit(prior.params, prior.zero_offsets_mm, effects), train, task.resolution))
-             for effects in fresh_starts]
+    costs = _probe_costs([ModelFit(prior.params, prior.zero_offsets_mm, effects) for effects in fresh_starts],
+                         train, task.resolution)
     fresh = (prior, fresh_starts[int(np.argmin(costs))])
     explored = [calibrate(task.train, base.params, prior=task.prior, zero_offsets_mm=base.zero_offsets_mm,
                           effects=effects, resolution=task.resolution, max_iterations=EXPLORE_ITERATIONS,
@@ -152,6 +152,14 @@ def run_task(task: FitTask) -> CandidateResult:
     errors = tuple(tip_errors(fit, task.holdout, task.resolution))
     result = evaluate(tuple(task.effects), fit, errors, task.baseline_errors, task.baseline_rmse_mm)
     return dataclasses.replace(result, seconds=time.perf_counter() - clock)
+
+
+def _probe_costs(fits: Sequence[ModelFit], train: Sequence[Recording], resolution: Resolution) -> list[float]:
+    """Training RMSE of each fit; runs slower than SLOW_RUN_FACTOR x the first are given up (inf)."""
+    clock = time.perf_counter()
+    costs = [rmse_mm(tip_errors(fits[0], train, resolution))]
+    limit = max(SLOW_RUN_FACTOR * (time.perf_counter() - clock), MIN_TIME_LIMIT_S)
+    return costs + [rmse_mm(tip_errors(fit, train, resolution, limit)) for fit in fits[1:]]
 
 
 def evaluate(effects: tuple[str, ...], fit: ModelFit, errors: Sequence[np.ndarray],

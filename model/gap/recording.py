@@ -73,7 +73,13 @@ class Recording:
         """
         if factor <= 1:
             return self
-        keep = slice(None, None, int(factor))
+        return self._subset(slice(None, None, int(factor)))
+
+    def head(self, count: int) -> "Recording":
+        """The first `count` samples."""
+        return self if count >= len(self) else self._subset(slice(0, int(count)))
+
+    def _subset(self, keep: slice) -> "Recording":
         force = None if self.tendon_force_n is None else self.tendon_force_n[keep]
         return Recording(self.name, self.t_s[keep], self.tendon_mm[keep], self.insertion_mm[keep],
                          self.tip_mm[keep], force, self.flexible_length_mm, self.tendon_offset_mm,

@@ -79,18 +79,21 @@ def regions(features: SampleFeatures) -> list[Region]:
 
 
 def breakdown(found: Sequence[Region], errors_mm: np.ndarray) -> list[dict]:
-    """rmse, share and concentration per region (see module doc), most concentrated first."""
+    """rmse, share and concentration per region (see module doc), most concentrated first.
+
+    "order" is the region's place in `regions` (groups in turn, bins in ascending order).
+    """
     squared = np.sum(np.asarray(errors_mm) ** 2, axis=1)
     total = float(squared.sum()) or 1.0
     n = len(squared)
     rows = []
-    for region in found:
+    for order, region in enumerate(found):
         part = squared[region.mask]
         share = float(part.sum()) / total
         fraction = len(part) / n
         rows.append({"region": region.name, "group": region.group, "rmse_mm": float(np.sqrt(part.mean())),
                      "share": share, "sample_fraction": fraction, "concentration": share / fraction,
-                     "samples": int(len(part))})
+                     "samples": int(len(part)), "order": order})
     return sorted(rows, key=lambda row: -row["concentration"])
 
 

@@ -30,21 +30,35 @@ class Resolution:
     max_tendon_step_mm, max_insertion_step_mm: quasi-static sub-step sizes (plant: 0.05, 0.5);
         insertion steps of 2 mm at 8 elements made the kernel return NaN on some paths.
     fit_rate_hz: recordings are decimated to about this rate for fitting and evaluation; the
-        smooth excitation loses nothing at 10 Hz, while the cost of a run scales with the
-        number of samples plus the path length over the sub-step size.
+        smooth excitation loses nothing at 10 Hz.
+    max_fit_samples: fits use at most this many (decimated) training samples in total, each
+        recording cut to its first part in proportion: a run costs about 10 us per sample and
+        sub-step, and the standard training excitation (about 230 s, 2300 samples) holds every
+        primitive, so a longer log repeats what the fit has already seen. Held-out recordings
+        are evaluated in full.
     """
 
     n_elements: int = 8
     max_tendon_step_mm: float = 0.25
     max_insertion_step_mm: float = 0.5
     fit_rate_hz: float = 10.0
+    max_fit_samples: int = 2400
 
     def decimation(self, recording: Recording) -> int:
         """The decimation factor that brings this recording to about `fit_rate_hz`."""
         return max(1, int(round(1.0 / (recording.sample_period_s * self.fit_rate_hz))))
 
     def prepare(self, recordings: Sequence[Recording]) -> list[Recording]:
+        """Recordings decimated to about `fit_rate_hz` (for evaluation)."""
         return [r.decimated(self.decimation(r)) for r in recordings]
+
+    def prepare_training(self, recordings: Sequence[Recording]) -> list[Recording]:
+        """Decimated, and cut so that the total is at most `max_fit_samples` (for fitting)."""
+        decimated = self.prepare(recordings)
+        total = sum(len(r) for r in decimated)
+        if total <= self.max_fit_samples:
+            return decimated
+        return [r.head(max(3, self.max_fit_samples * len(r) // total)) for r in decimated]
 
 
 def catheter_for(base: CatheterParams, recordings: Sequence[Recording]) -> CatheterParams:

@@ -1,0 +1,49 @@
+"""`crest fit TRAIN.csv [...] --out catheter.toml`: calibrate the base Dahl model on training logs."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from crest.gap.log_diagnosis import calibrate_logs, prior_catheter
+from model.gap.diagnosis import DiagnosisSettings
+
+FITTED = ("bending_stiffness_nmm2", "axial_stiffness_n", "mu", "sigma_n_per_mm2", "fsc_n_per_mm")
+
+
+def add_parser(sub) -> None:
+    parser = sub.add_parser("fit", help="calibrate the catheter model on training logs")
+    parser.add_argument("train", nargs="+", type=Path, help="training logs (crest-log/1 CSV with JSON sidecar)")
+    parser.add_argument("--out", required=True, type=Path, help="where to write the fitted catheter TOML")
+    parser.add_argument("--catheter", default=None, help="starting catheter TOML (default configs/catheter.toml)")
+    parser.add_argument("--json", dest="json_path", type=Path, default=None,
+                        help="also write the fit (values, std, correlations, flags) as JSON")
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    fit = calibrate_logs(args.train, args.catheter, DiagnosisSettings(),
+                         progress=lambda message: print(f"crest fit: {message}", file=sys.stderr, flush=True))
+    prior = prior_catheter(args.catheter)
+    fitted = prior.replace(tendon_offset_mm=fit.params.tendon_offset_mm,
+                           outer_diameter_mm=fit.params.outer_diameter_mm,
+                           **{name: getattr(fit.params, name) for name in FITTED})
+    header = [f"# Fitted by `crest fit` on {', '.join(str(p) for p in args.train)}",
+              f"# training tip RMSE {fit.train_rmse_mm:.3f} mm",
+              "# tendon zero offsets (mm, subtract from the drive position): "
+              + ", ".join(f"{z:+.5f}" for z in fit.zero_offsets_mm)]
+    header += [f"# FLAG: {flag}" for flag in fit.flags]
+    args.out.write_text("\n".join(header) + "\n" + fitted.to_toml())
+    if args.json_path:
+        args.json_path.write_text(json.dumps(fit.as_dict(), indent=2))
+    print(f"{'parameter':<24} {'value':>12} {'std':>10}")
+    for name, value, std in zip(fit.names, fit.values, fit.std):
+        print(f"{name:<24} {value:>12.5g} {std:>10.2g}")
+    print(f"training tip RMSE {fit.train_rmse_mm:.3f} mm")
+    for a, b, c in fit.strongest_correlations():
+        print(f"correlated: {a} / {b} ({c:+.2f})")
+    for flag in fit.flags:
+        print(f"FLAG: {flag} (the model may be bending this parameter to hide a missing effect; try `crest gap`)")
+    print(f"wrote {args.out}")
+    return 0

@@ -1,0 +1,90 @@
+"""`crest gap`: diagnose the sim-to-real gap of logs, or validate the diagnosis blind.
+
+    crest gap TRAIN.csv [...] --holdout TEST.csv [...] --json OUT.json --report DIR
+    crest gap --blind-benchmark --cases 40 --seed S --json OUT.json
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from crest.gap.blind_benchmark import run_blind_benchmark
+from crest.gap.log_diagnosis import diagnose_logs
+from crest.gap.log_recordings import load_recordings
+from crest.reports.gap_report import write_gap_report
+from model.gap.diagnosis import DiagnosisSettings
+
+
+def add_parser(sub) -> None:
+    parser = sub.add_parser("gap", help="diagnose the sim-to-real gap: where, which effect, how far it shrinks")
+    parser.add_argument("train", nargs="*", type=Path, help="training logs (crest-log/1)")
+    parser.add_argument("--holdout", nargs="+", type=Path, default=[], help="held-out logs (other trajectories)")
+    parser.add_argument("--json", dest="json_path", type=Path, default=None, help="write the result as JSON")
+    parser.add_argument("--report", type=Path, default=None, help="write report.md and PNG figures here")
+    parser.add_argument("--catheter", default=None, help="starting catheter TOML (default configs/catheter.toml)")
+    parser.add_argument("--workers", type=int, default=2, help="parallel candidate fits (default 2)")
+    parser.add_argument("--blind-benchmark", action="store_true",
+                        help="validate on model-plant logs whose effect is withheld instead")
+    parser.add_argument("--cases", type=int, default=40, help="blind benchmark: number of cases (default 40)")
+    parser.add_argument("--seed", type=int, default=0, help="blind benchmark: random seed")
+    parser.add_argument("--short", action="store_true", help="blind benchmark: the short excitation (faster)")
+    parser.set_defaults(handler=run)
+
+
+def _progress(message: str) -> None:
+    print(f"crest gap: {message}", file=sys.stderr, flush=True)
+
+
+def run(args: argparse.Namespace) -> int:
+    settings = DiagnosisSettings(workers=args.workers)
+    if args.blind_benchmark:
+        if args.train or args.holdout:
+            raise ValueError("--blind-benchmark makes its own logs; do not pass training or held-out logs")
+        result = run_blind_benchmark(args.cases, args.seed, short=args.short, settings=settings, progress=_progress)
+        _write_json(result, args.json_path)
+        print(format_score(result["score"]))
+        return 0
+    if not args.train or not args.holdout:
+        raise ValueError("give training logs and --holdout logs (recorded on other trajectories), "
+                         "e.g. `crest gap train.csv --holdout test.csv`")
+    result = diagnose_logs(args.train, args.holdout, args.catheter, settings, progress=_progress)
+    _write_json(result, args.json_path)
+    if args.report:
+        path = write_gap_report(result, load_recordings(args.holdout), args.report)
+        print(f"report written to {path}")
+    print(format_verdict(result))
+    return 0
+
+
+def _write_json(result: dict, path: Path | None) -> None:
+    if path:
+        path.write_text(json.dumps(result, indent=2))
+        print(f"results written to {path}")
+
+
+def format_verdict(result: dict) -> str:
+    verdict = result["verdict"]
+    lines = [f"baseline: train {result['baseline']['train_rmse_mm']:.3f} mm, held-out "
+             f"{result['baseline']['holdout_rmse_mm']:.3f} mm RMS",
+             "gap concentrates in: " + (", ".join(result["concentrated"][:5]) or "no region"),
+             f"verdict: {verdict['effect']}" + (f" ({' + '.join(verdict['effects'])})" if len(verdict["effects"]) > 1
+                                                else ""),
+             f"held-out {verdict['holdout_rmse_before_mm']:.3f} -> {verdict['holdout_rmse_after_mm']:.3f} mm, "
+             f"shrink {100 * verdict['shrink']:.1f} %"]
+    return "\n".join(lines + [f"  {line}" for line in verdict["residual"]])
+
+
+def format_score(score: dict) -> str:
+    def pct(value: float | None) -> str:
+        return "-" if value is None else f"{100 * value:.0f} %"
+
+    shrink = score["shrink_error_pp"] or {}
+    return "\n".join([
+        f"blind benchmark, {score['cases']} cases ({score['counts']})",
+        f"top-1 on single effects: {pct(score['top1_single'])} (target >= 90 %)",
+        f"'none' on clean cases: {pct(score['none_clean'])} (target >= 80 %)",
+        f"pairs: exact {pct(score['pair_exact'])}, at least one found {pct(score['pair_any_found'])}",
+        f"shrink error vs oracle: median {shrink.get('median', float('nan')):.1f} pp, "
+        f"within 10 pp {pct(shrink.get('within_10pp'))} (target: within 10 pp)"])

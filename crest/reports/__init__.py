@@ -1,0 +1,1 @@
+"""Reports written from analysis results (Markdown and PNG)."""
