@@ -482,6 +482,9 @@ def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_
             slack[:] = slack_before
             return False
         scalars[S_UNCONVERGED] += 1.0
+        if not (np.isfinite(new_force).all() and np.isfinite(new_tension).all() and np.isfinite(new_bend).all()):
+            slack[:] = slack_before     # never commit a diverged solve: keep the last equilibrium,
+            return True                 # the next step's global solve catches up with the input
 
     for k in range(4):
         drive = tip_tension[k]

@@ -90,7 +90,7 @@ def draw_cases(count: int, seed: int, prior: CatheterParams) -> list[BlindCase]:
     n_clean = round(CLEAN_FRACTION * count)
     n_pair = round(PAIR_FRACTION * count)
     ids = list(EFFECTS)
-    order = list(rng.permutation(ids))
+    order = [str(e) for e in rng.permutation(ids)]
     kinds = ["none"] * n_clean + ["pair"] * n_pair + ["single"] * (count - n_clean - n_pair)
     kinds = [kinds[i] for i in rng.permutation(count)]
     cases = []
@@ -136,8 +136,11 @@ def oracle_shrink(case: BlindCase, holdout: Path, baseline_rmse_mm: float, setti
 
 def run_case(case: BlindCase, folder: Path, prior: CatheterParams, settings: DiagnosisSettings,
              short: bool) -> dict:
-    """Record, diagnose blind, and compare with the truth."""
-    case, train, holdout = record_case(case, folder, prior, short)
+    """Record, diagnose blind, and compare with the truth. A plant that keeps diverging is skipped (reported)."""
+    try:
+        case, train, holdout = record_case(case, folder, prior, short)
+    except ModelSolverError as error:
+        return {"case": case.index, "kind": case.kind, "truth": list(case.effects), "skipped": str(error)}
     start = time.perf_counter()
     result = diagnose_logs([train], [holdout], settings=settings)
     seconds = time.perf_counter() - start
@@ -151,11 +154,14 @@ def run_case(case: BlindCase, folder: Path, prior: CatheterParams, settings: Dia
             "holdout_rmse_after_mm": verdict["holdout_rmse_after_mm"],
             "predicted_shrink": verdict["shrink"], "oracle_shrink": oracle,
             "shrink_error_pp": 100.0 * abs(verdict["shrink"] - oracle),
-            "top_candidates": [c["effect"] for c in result["candidates"][:3]], "seconds": seconds}
+            "top_candidates": [c["effect"] for c in result["candidates"][:3]], "seconds": seconds,
+            "timing_s": result["timing_s"],
+            "slowest_candidate": max(result["candidates"], key=lambda c: c["seconds"])["effect"]}
 
 
-def score(rows: list[dict]) -> dict:
-    """Confusion matrix and accuracies (see module doc)."""
+def score(all_rows: list[dict]) -> dict:
+    """Confusion matrix and accuracies (see module doc); skipped cases are counted, not scored."""
+    rows = [r for r in all_rows if "skipped" not in r]
     labels = list(EFFECTS) + ["none"]
     confusion = {t: {p: 0 for p in labels} for t in labels}
     for row in rows:
@@ -171,7 +177,7 @@ def score(rows: list[dict]) -> dict:
         return float(np.mean(hits)) if hits else None
 
     return {
-        "cases": len(rows),
+        "cases": len(all_rows),
         "top1_single": fraction([r["predicted"] == r["truth"][0] for r in singles]),
         "none_clean": fraction([r["predicted"] == "none" for r in clean]),
         "pair_exact": fraction([sorted(r["predicted_effects"]) == sorted(r["truth"]) for r in pairs]),
@@ -180,7 +186,8 @@ def score(rows: list[dict]) -> dict:
                             "max": float(np.max(errors)),
                             "within_10pp": float(np.mean([e <= 10.0 for e in errors]))} if errors else None,
         "confusion": confusion,
-        "counts": {"single": len(singles), "none": len(clean), "pair": len(pairs)},
+        "counts": {"single": len(singles), "none": len(clean), "pair": len(pairs),
+                   "skipped": len(all_rows) - len(rows)},
         "targets": TARGETS,
     }
 
@@ -199,6 +206,9 @@ def run_blind_benchmark(cases: int = 40, seed: int = 0, *, short: bool = False,
             folder.mkdir(parents=True, exist_ok=True)
             rows.append(run_case(case, folder, prior, settings, short))
             row = rows[-1]
+            if "skipped" in row:
+                say(f"blind case {case.index + 1}/{cases}: skipped, {row['skipped']}")
+                continue
             say(f"blind case {case.index + 1}/{cases}: truth {'+'.join(row['truth']) or 'none'}, "
                 f"verdict {'+'.join(row['predicted_effects']) or 'none'}, shrink {row['predicted_shrink']:.2f} "
                 f"(oracle {row['oracle_shrink']:.2f}), {row['seconds']:.0f} s")

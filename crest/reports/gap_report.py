@@ -150,7 +150,8 @@ def markdown(result: dict) -> str:
             lines.append(f"| {row['name']} | {row['baseline']:.4g} | {row['with_effect']:.4g} | {change} |")
     fit = base["fit"]
     lines += ["", "## Baseline calibration", "", "| parameter | value | std (lower bound) |", "|---|---|---|"]
-    lines += [f"| {name} | {p['value']:.4g} | {p['std']:.2g} |" for name, p in fit["parameters"].items()]
+    lines += [f"| {name} | {p['value']:.4g} | {'unidentified' if p['std'] is None else format(p['std'], '.2g')} |"
+              for name, p in fit["parameters"].items()]
     lines += ["", "Flags: " + ("; ".join(fit["flags"]) or "none"), "",
               "Strong correlations: " + ("; ".join(f"{c['a']} / {c['b']}: {c['correlation']:+.2f}"
                                                    for c in fit["strong_correlations"]) or "none"), ""]

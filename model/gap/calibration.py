@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
+from concurrent.futures import Executor
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -84,10 +85,11 @@ class ModelFit:
         return sorted(pairs, key=lambda pair: -abs(pair[2]))
 
     def as_dict(self) -> dict:
-        """Plain JSON-able description (parameters with std, correlations, flags, full catheter)."""
+        """Plain JSON-able description (parameters with std, None where unidentified; correlations, flags,
+        the full catheter)."""
         catheter = {name: (list(value) if isinstance(value, tuple) else value)
                     for name, value in vars(self.params).items()}
-        return {"parameters": {name: {"value": value, "std": std}
+        return {"parameters": {name: {"value": value, "std": std if math.isfinite(std) else None}
                                for name, value, std in zip(self.names, self.values, self.std)},
                 "tendon_zero_offsets_mm": list(self.zero_offsets_mm),
                 "effects": self.effect_params(),
@@ -133,11 +135,31 @@ def tip_errors(fit: ModelFit, recordings: Sequence[Recording], resolution: Resol
     return errors
 
 
+@dataclass
+class _Objective:
+    """Residual vector r(z) = tip_model - tip_measured over every valid sample (picklable for workers)."""
+
+    layout: ParameterLayout
+    start: CatheterParams
+    zero_start: np.ndarray
+    prepared: list[Recording]
+    resolution: Resolution
+    time_limit_s: float | None = None
+
+    def __call__(self, z: np.ndarray) -> np.ndarray:
+        params, zero, values = self.layout.unpack(z, self.start, self.zero_start)
+        out = np.concatenate(tip_errors(ModelFit(params, tuple(zero), values), self.prepared, self.resolution,
+                                        self.time_limit_s)).ravel()
+        if not np.all(np.isfinite(out)):   # the solver failed at these parameters: make them unattractive
+            out = np.full_like(out, DIVERGED_RESIDUAL_MM)
+        return out
+
+
 def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: CatheterParams | None = None,
               zero_offsets_mm: Sequence[float] = (0.0, 0.0, 0.0, 0.0),
               effects: Mapping[str, Sequence[float]] | None = None, fit_base: bool = True,
               resolution: Resolution = Resolution(), max_iterations: int = 30, restarts: int = MAX_RESTARTS,
-              on_evaluation: Callable[[int], None] | None = None) -> ModelFit:
+              executor: Executor | None = None, on_evaluation: Callable[[int], None] | None = None) -> ModelFit:
     """Fit the base parameters (unless fit_base is False) and the given effects' parameters.
 
     max_iterations bounds the cost evaluations of each least_squares run (not counting the
@@ -145,6 +167,8 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
     recordings: training recordings at full rate (decimated and capped here, Resolution.prepare_training).
     start: warm start; its geometry is replaced by the recordings'. prior: the catheter the
     physical ranges refer to (default: start). effects: {effect id: starting values}.
+    executor: evaluates the Jacobian's columns in parallel (forward differences as least_squares'
+    own '2-point' scheme); None evaluates them here.
     Returns a new ModelFit; `start` is unchanged.
     """
     prepared = resolution.prepare_training(recordings)
@@ -153,31 +177,43 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
     effects = {effect_id: tuple(values) for effect_id, values in (effects or {}).items()}
     layout = ParameterLayout(prior, tuple(effects), fit_base)
     zero_start = np.asarray(zero_offsets_mm, dtype=float)
+    objective = _Objective(layout, start, zero_start, prepared, resolution)
     runs = 0
     costs: list[float] = []
-    time_limit_s: float | None = None
+    last: list[tuple[bytes, np.ndarray]] = []
 
-    def residuals(z: np.ndarray) -> np.ndarray:
-        nonlocal runs, time_limit_s
-        params, zero, values = layout.unpack(z, start, zero_start)
-        clock = time.perf_counter()
-        out = np.concatenate(tip_errors(ModelFit(params, tuple(zero), values), prepared, resolution,
-                                        time_limit_s)).ravel()
-        if time_limit_s is None:   # the first run, at the start: the yardstick for a normal run
-            time_limit_s = max(SLOW_RUN_FACTOR * (time.perf_counter() - clock), MIN_TIME_LIMIT_S)
-        if not np.all(np.isfinite(out)):   # the solver failed at these parameters: make them unattractive
-            out = np.full_like(out, DIVERGED_RESIDUAL_MM)
+    def count(out: np.ndarray) -> None:
+        nonlocal runs
         runs += 1
         costs.append(0.5 * float(out @ out))
         if on_evaluation is not None:
             on_evaluation(runs)
+
+    def residuals(z: np.ndarray) -> np.ndarray:
+        clock = time.perf_counter()
+        out = objective(z)
+        if objective.time_limit_s is None:   # the first run, at the start: the yardstick for a normal run
+            objective.time_limit_s = max(SLOW_RUN_FACTOR * (time.perf_counter() - clock), MIN_TIME_LIMIT_S)
+        count(out)
+        last[:] = [(z.tobytes(), out)]
         return out
+
+    def parallel_jacobian(z: np.ndarray) -> np.ndarray:
+        f0 = last[0][1] if last and last[0][0] == z.tobytes() else residuals(z)
+        steps = DIFF_STEP * np.where(z >= 0, 1.0, -1.0) * np.maximum(1.0, np.abs(z))
+        steps = np.where(z + steps > high, -steps, steps)
+        points = [z + step * np.eye(len(z))[j] for j, step in enumerate(steps)]
+        columns = list(executor.map(objective, points))
+        for out in columns:
+            count(out)
+        return np.column_stack([(out - f0) / step for out, step in zip(columns, steps)])
 
     z = layout.pack(start, zero_start, effects)
     low, high = layout.bounds()
+    jac = "2-point" if executor is None else parallel_jacobian
     for _ in range(1 + restarts):
         first_run = runs
-        result = least_squares(residuals, z, bounds=(low, high), method="trf", diff_step=DIFF_STEP,
+        result = least_squares(residuals, z, jac=jac, bounds=(low, high), method="trf", diff_step=DIFF_STEP,
                                ftol=TOLERANCE, xtol=TOLERANCE, gtol=1e-8, max_nfev=max_iterations)
         improved = result.cost < (1.0 - RESTART_GAIN) * costs[first_run]
         z = result.x
@@ -186,8 +222,7 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
     params, zero, values = layout.unpack(result.x, start, zero_start)
     std_z, correlation = _statistics(result.jac, result.fun, len(result.x))
     physical = np.array([p.from_z(z) for p, z in zip(layout.parameters, result.x)])
-    std = np.array([abs(p.from_z(z + s) - p.from_z(z)) if np.isfinite(s) else math.inf
-                    for p, z, s in zip(layout.parameters, result.x, std_z)])
+    std = np.array([p.std(z, s) for p, z, s in zip(layout.parameters, result.x, std_z)])
     flags = tuple(f for p, v in zip(layout.parameters, physical) if (f := p.flag(float(v))) is not None)
     train_rmse = float(np.sqrt(np.sum(result.fun ** 2) / max(1, len(result.fun) // 3)))
     return ModelFit(params=params, zero_offsets_mm=tuple(float(v) for v in zero), effects=values,

@@ -20,7 +20,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import Executor, as_completed
 from dataclasses import dataclass
 
 import numpy as np
@@ -117,6 +117,7 @@ class FitTask:
     baseline_rmse_mm: float
     resolution: Resolution
     iterations: int = CANDIDATE_ITERATIONS
+    explore: bool = True    # False: fit from the start as given (pairs, controls)
 
     @property
     def prepared_train(self) -> list[Recording]:
@@ -126,7 +127,8 @@ class FitTask:
 def run_task(task: FitTask) -> CandidateResult:
     """Fit the task's effects with the base parameters and evaluate them on the held-out data.
 
-    Two starts, each explored by a short fit, the better one then fitted to the end:
+    With `explore` (single candidates), two starts, each explored by a short fit, the better one
+    then fitted to the end (otherwise the fit starts from the task's start and effect values):
     - continuation: the starting fit (baseline) with the new effect off;
     - fresh: the prior catheter with zero tendon zeros and the new effect at its best probe
       value (`probe_values`, one model run each). A baseline that lacks an effect has bent its
@@ -136,17 +138,20 @@ def run_task(task: FitTask) -> CandidateResult:
     clock = time.perf_counter()
     fixed = dict(task.effects)
     last = list(fixed)[-1] if fixed else None
-    train = task.prepared_train
-    prior = ModelFit(catheter_for(task.prior, train), (0.0, 0.0, 0.0, 0.0), {})
-    continuation = (task.start, {**fixed, last: start_values(last)} if last else {})
-    fresh_starts = [{**fixed, last: probe} if last else {} for probe in (probe_values(last) if last else [()])]
-    costs = _probe_costs([ModelFit(prior.params, prior.zero_offsets_mm, effects) for effects in fresh_starts],
-                         train, task.resolution)
-    fresh = (prior, fresh_starts[int(np.argmin(costs))])
-    explored = [calibrate(task.train, base.params, prior=task.prior, zero_offsets_mm=base.zero_offsets_mm,
-                          effects=effects, resolution=task.resolution, max_iterations=EXPLORE_ITERATIONS,
-                          restarts=0) for base, effects in (continuation, fresh)]
-    best = min(explored, key=lambda fit: fit.train_rmse_mm)
+    if task.explore:
+        train = task.prepared_train
+        prior = ModelFit(catheter_for(task.prior, train), (0.0, 0.0, 0.0, 0.0), {})
+        continuation = (task.start, {**fixed, last: start_values(last)} if last else {})
+        fresh_starts = [{**fixed, last: probe} if last else {} for probe in (probe_values(last) if last else [()])]
+        costs = _probe_costs([ModelFit(prior.params, prior.zero_offsets_mm, effects) for effects in fresh_starts],
+                             train, task.resolution)
+        fresh = (prior, fresh_starts[int(np.argmin(costs))])
+        explored = [calibrate(task.train, base.params, prior=task.prior, zero_offsets_mm=base.zero_offsets_mm,
+                              effects=effects, resolution=task.resolution, max_iterations=EXPLORE_ITERATIONS,
+                              restarts=0) for base, effects in (continuation, fresh)]
+        best = min(explored, key=lambda fit: fit.train_rmse_mm)
+    else:
+        best = ModelFit(task.start.params, task.start.zero_offsets_mm, fixed)
     fit = calibrate(task.train, best.params, prior=task.prior, zero_offsets_mm=best.zero_offsets_mm,
                     effects=best.effects, resolution=task.resolution, max_iterations=task.iterations)
     errors = tuple(tip_errors(fit, task.holdout, task.resolution))
@@ -176,10 +181,10 @@ def evaluate(effects: tuple[str, ...], fit: ModelFit, errors: Sequence[np.ndarra
     return CandidateResult(effects, fit, holdout_rmse, tuple(errors), shrink, match, score)
 
 
-def run_tasks(tasks: Sequence[FitTask], workers: int = 2,
+def run_tasks(tasks: Sequence[FitTask], executor: Executor | None = None,
               on_done: Callable[[CandidateResult], None] | None = None) -> list[CandidateResult]:
-    """Run the fits in `workers` processes (in this process when workers <= 1); results in task order."""
-    if workers <= 1 or len(tasks) <= 1:
+    """Run the fits on the executor's workers (here, one after the other, without one); results in task order."""
+    if executor is None:
         results = []
         for task in tasks:
             results.append(run_task(task))
@@ -187,12 +192,11 @@ def run_tasks(tasks: Sequence[FitTask], workers: int = 2,
                 on_done(results[-1])
         return results
     results: list[CandidateResult | None] = [None] * len(tasks)
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        futures = {pool.submit(run_task, task): index for index, task in enumerate(tasks)}
-        for future in as_completed(futures):
-            results[futures[future]] = future.result()
-            if on_done is not None:
-                on_done(results[futures[future]])
+    futures = {executor.submit(run_task, task): index for index, task in enumerate(tasks)}
+    for future in as_completed(futures):
+        results[futures[future]] = future.result()
+        if on_done is not None:
+            on_done(results[futures[future]])
     return results
 
 

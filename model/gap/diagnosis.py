@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
+from concurrent.futures import Executor, ProcessPoolExecutor
+from contextlib import nullcontext
 from dataclasses import asdict, dataclass, replace
 
 import numpy as np
@@ -60,12 +62,19 @@ def diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: Ca
     if not train or not holdout:
         raise RecordingError("the diagnosis needs at least one training and one held-out recording")
     say = progress or (lambda message: None)
+    with ProcessPoolExecutor(settings.workers) if settings.workers > 1 else nullcontext() as pool:
+        return _diagnose(train, holdout, prior, settings, say, pool)
+
+
+def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: CatheterParams,
+              settings: DiagnosisSettings, say: Callable[[str], None], pool: Executor | None) -> dict:
+    """The steps of `diagnose` with one worker pool for the baseline's Jacobian, candidates and pairs."""
     res = settings.resolution
     clock = time.perf_counter()
     timing: dict[str, float] = {}
-
     say(f"baseline: calibrating on {len(train)} training recording(s)")
     baseline = calibrate(train, prior, prior=prior, resolution=res, max_iterations=settings.baseline_iterations,
+                         executor=pool,
                          on_evaluation=lambda n: say(f"baseline: {n} model runs") if n % 50 == 0 else None)
     held = res.prepare(holdout)
     base_errors = _holdout_errors(baseline, held, res)
@@ -73,15 +82,15 @@ def diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: Ca
     noise = tracker_noise_mm(list(train) + list(holdout))
     timing["baseline"] = time.perf_counter() - clock
 
-    def task(effects: dict, start: ModelFit) -> FitTask:
+    def task(effects: dict, start: ModelFit, explore: bool = True) -> FitTask:
         return FitTask(effects, start, prior, tuple(train), tuple(held), tuple(base_errors), base_rmse, res,
-                       settings.candidate_iterations)
+                       settings.candidate_iterations, explore)
 
     ids = list(settings.effects)
     say(f"candidates: fitting {len(ids)} effects and a plain refit on {settings.workers} worker(s)")
     done = []
     results = run_tasks([task({}, baseline)] + [task({i: start_values(i)}, baseline) for i in ids],
-                        settings.workers, lambda r: done.append(r) or say(
+                        pool, lambda r: done.append(r) or say(
                             f"candidates: {len(done)}/{len(ids) + 1} done ({'+'.join(r.effects) or 'refit'})"))
     refit, singles = results[0], results[1:]
     if refit.fit.train_rmse_mm < baseline.train_rmse_mm:   # the control got further: it is the baseline
@@ -97,9 +106,9 @@ def diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: Ca
         best = singles[0]
         others = [r.effects[0] for r in singles[1:1 + settings.pair_candidates]]
         say(f"pairs: {best.effects[0]} alone (control) and with each of {', '.join(others)}")
-        continued, *pairs = run_tasks([task(dict(best.fit.effects), best.fit)]
-                                      + [task({**best.fit.effects, other: start_values(other)}, best.fit)
-                                         for other in others], settings.workers)
+        continued, *pairs = run_tasks([task(dict(best.fit.effects), best.fit, explore=False)]
+                                      + [task({**best.fit.effects, other: start_values(other)}, best.fit, False)
+                                         for other in others], pool)
         if continued.fit.train_rmse_mm < best.fit.train_rmse_mm:   # the control got further: it is the single
             best = replace(continued, seconds=best.seconds + continued.seconds)
             singles[0] = best
@@ -173,6 +182,6 @@ def _base_change(before: ModelFit, after: ModelFit) -> list[dict]:
                                before.std[:N_BASE]):
         rows.append({"name": name, "baseline": a, "with_effect": b, "change": b - a,
                      "relative_change": (b - a) / a if a != 0 and not name.startswith("tendon_zero") else None,
-                     "baseline_std": std})
+                     "baseline_std": std if np.isfinite(std) else None})
     return rows
 

@@ -44,6 +44,12 @@ class FreeParameter:
             return self.log_reference * math.exp(z)
         return z * self.scale
 
+    def std(self, z: float, std_z: float) -> float:
+        """The standard deviation in physical units of one with std_z in z (one-sided for log scaling)."""
+        if not np.isfinite(std_z) or (self.log_reference is not None and z + std_z > 700.0):
+            return math.inf
+        return abs(self.from_z(z + std_z) - self.from_z(z))
+
     def flag(self, value: float) -> str | None:
         """Why the fitted value is suspicious, or None (a bound counts when within 0.1 % of the z range)."""
         z, z_low, z_high = self.to_z(value), self.to_z(self.lower), self.to_z(self.upper)

@@ -1,0 +1,37 @@
+"""Blind benchmark bookkeeping (issue 6, blind validation): the draw and the scores."""
+import pytest
+
+from crest.gap.blind_benchmark import draw_cases, score
+from model import CatheterParams
+from model.effects import EFFECTS
+
+
+def test_draw_holds_clean_single_and_pair_cases_with_hidden_plants():
+    cases = draw_cases(40, seed=3, prior=CatheterParams.from_toml())
+    kinds = [c.kind for c in cases]
+    assert kinds.count("none") == 8 and kinds.count("pair") == 6 and kinds.count("single") == 26
+    singles = {c.effects[0] for c in cases if c.kind == "single"}
+    assert singles == set(EFFECTS)                 # every effect is drawn
+    assert all(len(c.effects) == 2 and c.effects[0] != c.effects[1] for c in cases if c.kind == "pair")
+    assert all(c.effects == () for c in cases if c.kind == "none")
+    assert len({c.plant.params.mu for c in cases}) == 40      # each plant differs from the others
+    assert draw_cases(40, seed=3, prior=CatheterParams.from_toml())[5] == cases[5]   # reproducible
+
+
+def row(kind, truth, predicted, effects=None, predicted_shrink=0.5, oracle=0.5):
+    return {"kind": kind, "truth": truth, "predicted": predicted,
+            "predicted_effects": effects if effects is not None else ([] if predicted == "none" else [predicted]),
+            "shrink_error_pp": 100 * abs(predicted_shrink - oracle)}
+
+
+def test_scores_count_hits_misses_and_shrink_errors():
+    rows = [row("single", ["backlash"], "backlash"), row("single", ["gravity"], "tracker_offset", oracle=0.3),
+            row("none", [], "none", predicted_shrink=0.0, oracle=0.01), row("none", [], "torsion"),
+            row("pair", ["backlash", "torsion"], "torsion", ["torsion", "backlash"]),
+            row("pair", ["gravity", "torsion"], "torsion", ["torsion"])]
+    result = score(rows)
+    assert result["top1_single"] == 0.5 and result["none_clean"] == 0.5
+    assert result["pair_exact"] == 0.5 and result["pair_any_found"] == 1.0
+    assert result["confusion"]["gravity"]["tracker_offset"] == 1 and result["confusion"]["none"]["torsion"] == 1
+    assert result["shrink_error_pp"]["max"] == pytest.approx(20.0)
+    assert result["shrink_error_pp"]["within_10pp"] == pytest.approx(5 / 6)
