@@ -399,6 +399,7 @@ def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_
         if _tip_tensions(u, compliance, dist_force, dist_short, slack, revived, tip_tension, tip_scratch):
             continue
         worst = 0.0
+        finite = True          # max() drops NaN, so a diverged iterate is caught here
         ka = h / params[P_EA]
         kt = h / params[P_EAT]
         for k in range(4):
@@ -471,10 +472,13 @@ def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_
                     gt[k, i] = -2.0 if distal_tension > 0.0 else 0.0
                     gth[k, i] = 0.0
                 new_force[k, i] = f0[k, i]
-                worst = max(worst, abs(f0[k, i] - linear_force[k]))
+                mismatch = abs(f0[k, i] - linear_force[k])
+                if not math.isfinite(mismatch):
+                    finite = False
+                worst = max(worst, mismatch)
                 xref[k, i] = new_sliding[k, i]
                 tref[k, i] = new_tension[k, i]
-        if worst < FORCE_TOLERANCE_N:
+        if finite and worst < FORCE_TOLERANCE_N:
             converged = True
             break
     if not converged:
