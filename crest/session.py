@@ -13,9 +13,11 @@ from pathlib import Path
 from crest.backend import Backend, open_backend
 from crest.config import TestbedConfig, load_testbed_config
 from crest.driver import MonotonicClock, SteppedClock, Testbed
+from crest.experiment.tip_feed import TipFeed
 from crest.tracker import AuroraDriver
 
-TRACKER_RATE_HZ = 40.0
+TRACKER_RATE_HZ = 40.0          # the Aurora's sample rate
+FAST_TRACKER_POLL_HZ = 400.0    # in simulated time the driver polls faster, so fresh frames come quickly
 
 
 @dataclass
@@ -24,6 +26,11 @@ class Session:
     backend: Backend
     testbed: Testbed
     tracker: AuroraDriver | None
+    realtime: bool = True
+
+    def tip_feed(self) -> TipFeed:
+        """Tip samples on the loop's clock (paced to the tracker rate when time is simulated)."""
+        return TipFeed(self.tracker, None if self.realtime else 1.0 / TRACKER_RATE_HZ)
 
 
 @dataclass(frozen=True)
@@ -58,8 +65,9 @@ def open_session(options: SessionOptions = SessionOptions()) -> Iterator[Session
         testbed = Testbed(backend.bus, config, clock=clock)
         tracker = None
         if options.tracker:
+            rate_hz = options.tracker_rate_hz if options.realtime else FAST_TRACKER_POLL_HZ
             tracker = AuroraDriver(backend.tracker_port, baudrate=config.tracker.baudrate,
-                                   tool_port=config.tracker.tool_port, rate_hz=options.tracker_rate_hz)
+                                   tool_port=config.tracker.tool_port, rate_hz=rate_hz)
             tracker.start()
             stack.callback(tracker.stop)
         with testbed:
@@ -67,4 +75,4 @@ def open_session(options: SessionOptions = SessionOptions()) -> Iterator[Session
                 testbed.boot()
             else:
                 testbed.connect()
-            yield Session(config, backend, testbed, tracker)
+            yield Session(config, backend, testbed, tracker, options.realtime)

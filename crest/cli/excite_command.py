@@ -17,7 +17,6 @@ from crest.driver import AxisTargets
 from crest.driver.motion_limits import check_trajectory
 from crest.experiment.recorder import ExperimentRecorder
 from crest.experiment.time_scaling import slow_to_limits
-from crest.experiment.tip_feed import TipFeed
 from crest.session import open_session
 
 
@@ -53,7 +52,7 @@ def run(args: argparse.Namespace) -> int:
             recorder = ExperimentRecorder(session, args.record / f"{name}.csv", params,
                                           source=f"crest excite: {trajectory.name}", tip_ref=False,
                                           notes="excitation for crest fit / crest gap")
-            feed = TipFeed(session.tracker)
+            feed = session.tip_feed()
             progress = ProgressBar(len(samples[name]), f"excite {name}")
             done = [0]
 

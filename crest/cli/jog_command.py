@@ -17,7 +17,6 @@ from crest.cli.common_options import (add_record_option, add_testbed_options, ca
 from crest.cli.keyboard import Keyboard
 from crest.driver import AXIS_ORDER, AxisTargets
 from crest.experiment.recorder import ExperimentRecorder
-from crest.experiment.tip_feed import TipFeed
 from crest.experiment.workspace_from_config import workspace_for
 from crest.session import open_session
 
@@ -102,7 +101,7 @@ def run(args: argparse.Namespace) -> int:
         state = JogState(workspace, testbed.positions().insertion_mm, session.config.coordination.pretension_mm)
         path = record_path(args.record, "jog")
         recorder = ExperimentRecorder(session, path, params, source="jog", tip_ref=False) if path else None
-        feed = TipFeed(session.tracker)
+        feed = session.tip_feed()
         print(__doc__.split("\n\n")[1], file=sys.stderr)
         cycles = 0
         while True:

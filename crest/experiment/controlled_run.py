@@ -15,7 +15,6 @@ import numpy as np
 from control import Controller, SetPoint, TrackerLostError
 from crest.driver import AxisTargets
 from crest.experiment.recorder import ExperimentRecorder
-from crest.experiment.tip_feed import TipFeed
 from crest.session import Session
 
 
@@ -31,7 +30,7 @@ def run_with_controller(session: Session, setpoints: Iterable[SetPoint], control
                         recorder: ExperimentRecorder | None = None, closed_loop: bool = False,
                         on_cycle: Callable[[int], None] | None = None) -> RunResult:
     testbed = session.testbed
-    feed = TipFeed(session.tracker)
+    feed = session.tip_feed()
     if closed_loop:
         testbed.watch_tracker(feed.age_s)
     controller.reset(insertion_mm=testbed.positions().insertion_mm)

@@ -4,6 +4,10 @@ The tracker driver stamps samples with the host's monotonic clock; the loop may 
 simulated time. A sample is taken as new when its frame number changes, and is stamped with
 the loop time at which it was first seen, so both clocks agree (tracker latency is below one
 cycle of the 40 Hz tracker). `age_s` is the loop time since the last valid tip.
+
+In simulated time (`sample_period_s` given) the loop runs faster than the wall-clock tracker, so
+the feed asks for a fresh frame once per tracker period of simulated time and waits for it:
+the samples then describe the simulated catheter at that instant, as a real tracker would.
 """
 from __future__ import annotations
 
@@ -15,9 +19,14 @@ from control import TipMeasurement
 from crest.tracker import AuroraDriver
 
 
+FRESH_SAMPLE_TIMEOUT_S = 0.2
+
+
 class TipFeed:
-    def __init__(self, tracker: AuroraDriver | None):
+    def __init__(self, tracker: AuroraDriver | None, sample_period_s: float | None = None):
         self.tracker = tracker
+        self.sample_period_s = sample_period_s
+        self._next_sample_s = 0.0
         self._frame: int | None = None
         self._last_valid_s: float | None = None
         self._now_s = 0.0
@@ -28,7 +37,16 @@ class TipFeed:
         self._now_s = now_s
         if self.tracker is None:
             return None
-        sample = self.tracker.latest()
+        if self.sample_period_s is None:
+            sample = self.tracker.latest()
+        elif now_s + 1e-9 < self._next_sample_s:
+            return None
+        else:
+            self._next_sample_s = now_s + self.sample_period_s
+            try:
+                sample = self.tracker.wait_next(FRESH_SAMPLE_TIMEOUT_S)
+            except TimeoutError:       # the link is down: the age keeps growing
+                return None
         if sample is None or sample.frame == self._frame:
             return None
         self._frame = sample.frame
