@@ -131,8 +131,9 @@ def describe(signature: dict, where: Sequence[dict], holdout_rmse_mm: float) -> 
     noise = signature.get("noise_mm")
     if noise is not None:
         floor = float(np.sqrt(3) * noise)
-        lines.append(f"held-out RMSE {holdout_rmse_mm:.3f} mm against a tracker noise floor of {floor:.3f} mm "
-                     f"({holdout_rmse_mm / floor:.1f}x)")
+        ratio = f" ({holdout_rmse_mm / floor:.1f}x)" if floor > 0 else " (no sample-to-sample noise: held samples)"
+        lines.append(f"held-out RMSE {holdout_rmse_mm:.3f} mm against a tracker noise floor of {floor:.3f} mm"
+                     + ratio)
     for row in where[:3]:
         if row["concentration"] >= 1.5:
             lines.append(f"concentrated in {row['region']} ({row['concentration']:.1f}x its share of samples, "
