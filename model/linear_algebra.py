@@ -36,24 +36,6 @@ def solve_in_place(a, b, n: int, m: int) -> bool:
 
 
 @kernel
-def solve_diagonally_dominant(a, b, n: int, m: int) -> None:
-    """Solve A X = B in place like solve_in_place, without pivoting.
-
-    Valid when A is strictly diagonally dominant (Gaussian elimination then needs no row
-    exchanges and is stable), as I - K D/4 - G/2 is for the friction linearisation.
-    """
-    for col in range(n):
-        inv = 1.0 / a[col, col]
-        for row in range(col + 1, n):
-            factor = a[row, col] * inv
-            for j in range(col + 1, n):
-                a[row, j] -= factor * a[col, j]
-            for j in range(m):
-                b[row, j] -= factor * b[col, j]
-    _back_substitute(a, b, n, m)
-
-
-@kernel
 def _back_substitute(a, b, n: int, m: int) -> None:
     """X from the upper triangle of A (after elimination): b holds X on return."""
     for col in range(n - 1, -1, -1):

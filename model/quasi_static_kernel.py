@@ -48,7 +48,7 @@ from model.backbone_geometry import compose_backbone
 from model.dahl_friction import capstan_gain, dahl_update_with_slopes
 from model.effect_terms import (E_BACKLASH, E_GX, E_GY, E_GZ, E_KAPPA0_X, E_KAPPA0_Y, E_LUMEN_COEF,
                                 E_LUMEN_EXTENT, E_RATE, E_TENDON_COMPLIANCE, E_TUBE_PLAY, E_TWIST)
-from model.linear_algebra import solve_diagonally_dominant, solve_in_place
+from model.linear_algebra import solve_in_place
 
 # Positions in the kernel's parameter vector (see DahlCatheter._kernel_params).
 P_R = 0        # tendon offset r, mm
@@ -158,11 +158,13 @@ def _sweep(n, h, params, arm, cos_phi, sin_phi, ext_bend, f0, kx, gt, gth, bend_
     K = diag(dF/dx). G_km = dF_k/dT_m holds the capstan dependence of Fs on the tendon's own
     tension, gt_k (k = m), and on the element angle theta, which every tension bends:
     gth_k * dtheta/dT_m with dtheta/dT_m = (r/K_b) (u . e_m), u the unit bend direction.
+    So I - G/2 = Delta - (1/2) gth w^T: diagonal plus rank one (`_solve_diagonal_plus_rank_one`).
+    A slack tendon's row is F = 0.
     """
     kb = params[P_EI] / h
     ka = h / params[P_EA]
     kt = h / params[P_EAT]
-    a, rhs, pull, dp, w_pull, d0, w = scratch
+    inv_diag, coupling, rhs, pull, dp, w_pull, d0, w = scratch
     dist_force[:, :] = 0.0
     dist_short[:, :] = 0.0
     for i in range(n - 1, -1, -1):
@@ -180,26 +182,24 @@ def _sweep(n, h, params, arm, cos_phi, sin_phi, ext_bend, f0, kx, gt, gth, bend_
         _apply_d(ka, c, kt, e0, e1, pull, dp)
         for col in range(5):
             w_pull[col] = w[0] * pull[0, col] + w[1] * pull[1, col] + w[2] * pull[2, col] + w[3] * pull[3, col]
+        w_tref = w[0] * tref[0, i] + w[1] * tref[1, i] + w[2] * tref[2, i] + w[3] * tref[3, i]
         for k in range(4):
             if slack[k]:
-                for m in range(4):
-                    a[k, m] = 0.0
-                a[k, k] = 1.0
+                inv_diag[k] = 1.0
+                coupling[k] = 0.0
                 for col in range(5):
                     rhs[k, col] = 0.0
                 continue
             kk = kx[k, i]
             gk = gt[k, i]
             hk = gth[k, i]
-            # G_km = gt_k delta_km + gth_k w_m;  D_km = ka + c e_k.e_m + kt delta_km
-            for m in range(4):
-                a[k, m] = -0.5 * hk * w[m]
-            a[k, k] += 1.0 - 0.5 * gk
-            w_tref = w[0] * tref[0, i] + w[1] * tref[1, i] + w[2] * tref[2, i] + w[3] * tref[3, i]
+            inv_diag[k] = 1.0 / (1.0 - 0.5 * gk)
+            coupling[k] = hk * inv_diag[k]
             for col in range(5):
-                rhs[k, col] = kk * (dist_short[k, col] + 0.5 * dp[k, col]) + gk * pull[k, col] + hk * w_pull[col]
-            rhs[k, 0] += f0[k, i] + kk * (0.5 * d0[k] - xref[k, i]) - gk * tref[k, i] - hk * w_tref
-        solve_diagonally_dominant(a, rhs, 4, 5)
+                rhs[k, col] = inv_diag[k] * (kk * (dist_short[k, col] + 0.5 * dp[k, col]) + gk * pull[k, col]
+                                             + hk * w_pull[col])
+            rhs[k, 0] += inv_diag[k] * (f0[k, i] + kk * (0.5 * d0[k] - xref[k, i]) - gk * tref[k, i] - hk * w_tref)
+        _solve_diagonal_plus_rank_one(coupling, w, rhs)
         for k in range(4):
             for col in range(5):
                 force = rhs[k, col]
@@ -211,6 +211,21 @@ def _sweep(n, h, params, arm, cos_phi, sin_phi, ext_bend, f0, kx, gt, gth, bend_
             for col in range(5):
                 dist_short[k, col] += dp[k, col]
             dist_short[k, 0] += d0[k]
+
+
+@kernel
+def _solve_diagonal_plus_rank_one(q, w, y):
+    """Solve (Delta - (1/2) h w^T) X = B in place, given q = Delta^-1 h and y = Delta^-1 B.
+
+    Sherman-Morrison: X = y + q (w^T y) / (2 - w^T q), column by column. The friction
+    linearisation keeps 2 - w^T q well away from 0 (it is diagonally dominant).
+    """
+    wq = w[0] * q[0] + w[1] * q[1] + w[2] * q[2] + w[3] * q[3]
+    scale = 1.0 / (2.0 - wq)
+    for col in range(y.shape[1]):
+        beta = scale * (w[0] * y[0, col] + w[1] * y[1, col] + w[2] * y[2, col] + w[3] * y[3, col])
+        for k in range(4):
+            y[k, col] += beta * q[k]
 
 
 @kernel
@@ -336,7 +351,7 @@ def make_workspace(n):
             np.empty((4, n)), np.empty((n, 2)), np.empty(n), np.empty((4, n)), np.empty(4),
             np.zeros(4, dtype=np.bool_), np.empty(n), np.zeros((4, n), dtype=np.bool_), np.empty(4),
             np.zeros((4, n), dtype=np.bool_), np.zeros(4, dtype=np.bool_),
-            (np.empty((4, 4)), np.empty((4, 5)), np.empty((4, 5)), np.empty((4, 5)), np.empty(5), np.empty(4),
+            (np.empty(4), np.empty(4), np.empty((4, 5)), np.empty((4, 5)), np.empty((4, 5)), np.empty(5), np.empty(4),
              np.empty(4)),
             (np.empty((4, 5)), np.zeros(4, dtype=np.bool_), np.zeros(4, dtype=np.bool_), np.empty((4, 4)),
              np.empty((4, 1)), np.empty(4, dtype=np.int64)))
