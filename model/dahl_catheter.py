@@ -57,7 +57,10 @@ class CatheterState:
                    np.zeros(N_SCALARS))
 
     def copy(self) -> "CatheterState":
-        return CatheterState(**{f.name: getattr(self, f.name).copy() for f in dataclasses.fields(self)})
+        return CatheterState(*[getattr(self, name).copy() for name in _STATE_FIELDS])
+
+
+_STATE_FIELDS = tuple(f.name for f in dataclasses.fields(CatheterState))
 
 
 class DahlCatheter:
@@ -161,6 +164,11 @@ class DahlCatheter:
             raise ModelInputError(f"tendon commands must have shape (T, 4), got {tendons.shape}")
         if insertion.shape != (tendons.shape[0],):
             raise ModelInputError(f"insertion must have shape ({tendons.shape[0]},), got {insertion.shape}")
+        low, high = self.params.tendon_range_mm
+        lo, hi = self.params.min_free_length_mm, self.params.max_free_length_mm
+        # one pass for the common case: a range check fails for NaN and inf as well
+        if ((tendons >= low) & (tendons <= high)).all() and ((insertion >= lo) & (insertion <= hi)).all():
+            return np.ascontiguousarray(tendons), np.ascontiguousarray(insertion)
         bad = ~np.isfinite(tendons)
         if bad.any():
             t, k = np.argwhere(bad)[0]
@@ -168,19 +176,17 @@ class DahlCatheter:
         if not np.isfinite(insertion).all():
             t = int(np.argwhere(~np.isfinite(insertion))[0, 0])
             raise ModelInputError(f"insertion at sample {t} is {insertion[t]}: must be finite")
-        low, high = self.params.tendon_range_mm
         outside = (tendons < low) | (tendons > high)
         if outside.any():
             t, k = np.argwhere(outside)[0]
             raise ModelInputError(f"tendon {k + 1} command {tendons[t, k]:.3f} mm at sample {t} is outside "
                                   f"the configured range [{low}, {high}] mm")
-        lo, hi = self.params.min_free_length_mm, self.params.max_free_length_mm
         outside = (insertion < lo) | (insertion > hi)
         if outside.any():
             t = int(np.argwhere(outside)[0, 0])
             raise ModelInputError(f"free length {insertion[t]:.3f} mm at sample {t} is outside "
                                   f"[{lo}, {hi}] mm (it cannot be negative or beyond the catheter)")
-        return np.ascontiguousarray(tendons), np.ascontiguousarray(insertion)
+        raise ModelInputError("tendon or insertion command outside its range")
 
     # -- outputs -----------------------------------------------------------------------
     @property
