@@ -91,6 +91,7 @@ class DahlCatheter:
         self._kernel_params = self._pack(params)
         self._kernel_effects = effects.kernel_vector()
         self._tracker_offset_mm = np.asarray(effects.tracker_offset_mm, dtype=float)
+        self._point_loads = np.empty((0, 4))     # (fx, fy, fz [N], distance from the tip [mm])
         self.reset()
 
     @staticmethod
@@ -118,6 +119,33 @@ class DahlCatheter:
 
     def restore(self, state: CatheterState) -> None:
         self.state = state.copy()
+
+    # -- external loads ----------------------------------------------------------------
+    def set_point_forces(self, forces_n, from_tip_mm=None) -> None:
+        """External point forces on the catheter, from the next move on (replacing earlier ones).
+
+        forces_n (K, 3) in N in the base frame; from_tip_mm (K,) their distance from the tip along
+        the backbone [mm] (default 0: at the tip), so a contact stays where it is on the catheter
+        when the insertion changes. A force whose point is inside the support tube acts on the tube.
+        The forces bend each element through the contact-point Jacobian (seed paper II). They act
+        on the shape of the previous sub-step, so after a large change of load call move_to again
+        until the tip settles. `set_point_forces(np.empty((0, 3)))` removes them.
+        """
+        forces = np.asarray(forces_n, dtype=float).reshape(-1, 3)
+        distances = np.zeros(len(forces)) if from_tip_mm is None else np.asarray(from_tip_mm, float).reshape(-1)
+        if distances.shape != (len(forces),):
+            raise ModelInputError(f"from_tip_mm must hold one distance per force ({len(forces)}), "
+                                  f"got shape {distances.shape}")
+        if not (np.isfinite(forces).all() and np.isfinite(distances).all()):
+            raise ModelInputError("point forces and their distances from the tip must be finite")
+        if (distances < 0).any():
+            raise ModelInputError(f"distances from the tip must be >= 0 mm, got {distances.min():g}")
+        self._point_loads = np.ascontiguousarray(np.column_stack([forces, distances]))
+
+    @property
+    def point_forces_n(self) -> np.ndarray:
+        """(K, 3) external point forces now acting [N], base frame."""
+        return self._point_loads[:, :3].copy()
 
     # -- motion ------------------------------------------------------------------------
     def move_to(self, tendons_mm, insertion_mm: float | None = None) -> np.ndarray:
@@ -149,7 +177,7 @@ class DahlCatheter:
         s = self.state
         tips = np.empty((len(tendons), 3))
         run_path(tendons, insertion, dt_s, self.max_tendon_step_mm, self.max_insertion_step_mm,
-                 self._kernel_params, self._kernel_effects, s.applied_tendon_mm, s.applied_insertion_mm,
+                 self._kernel_params, self._kernel_effects, self._point_loads, s.applied_tendon_mm, s.applied_insertion_mm,
                  s.friction_n, s.sliding_mm, s.last_step_mm, s.tension_n, s.bend_rad, s.compression_mm,
                  s.tip_tension_n, s.drive_tension_n, s.slack, s.points_mm, s.frames, s.diagnostics, tips)
         if not (np.isfinite(tips).all() and np.isfinite(s.friction_n).all()):

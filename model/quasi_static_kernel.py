@@ -83,15 +83,21 @@ def play_operator(previous: float, target: float, width: float) -> float:
 
 
 @kernel
-def _element_modifiers(n, length, params, effects, tension, bend_prev, points, frames,
+def _element_modifiers(n, length, params, effects, point_loads, tension, points, frames,
                        arm, angle, rest_bend, ext_bend):
-    """Per-element terms from the effect vector and the previous step's state.
+    """Per-element terms from the effect vector, the external loads and the previous step's state.
 
     arm_i = r / (1 + c_lumen * sum_k T_ki * exp(-s_i / extent))      (lumen compression)
     angle offset_i = twist * (i + 1/2) / N                           (torsion)
     b_rest,i = kappa0 * h                                            (precurvature)
-    b_ext,i from the gravity moment M_i = sum_{j>=i} (c_j - p_i) x (m_j g) in the
-    frame of element i: b_ext = (M_y, -M_x) / K_b (generalised force = J^T F).
+    b_ext,i = (M_y, -M_x) / K_b: the generalised force J^T F of the loads distal to element i's
+    base p_i (seed paper II: external forces through the contact-point Jacobian), with
+        M_i = sum_{j>=i} (c_j - p_i) x (m_j g)  +  sum_{loads at s > s_i} (q - p_i) x F
+    in the frame of element i: the element weights (gravity effect) at the element centres c_j,
+    and the point loads (fx, fy, fz [N], distance d [mm] from the tip) at the backbone point
+    q at arc length s = L - d. Loads inside the support tube (d >= L) act on the tube. The
+    moment arms come from the previous step's shape; the axial part of the loads is neglected
+    (EA is orders stiffer than the tendon loads need).
     """
     h = length / n
     kb = params[P_EI] / h
@@ -108,27 +114,27 @@ def _element_modifiers(n, length, params, effects, tension, bend_prev, points, f
         rest_bend[i, 1] = effects[E_KAPPA0_Y] * h
         ext_bend[i, 0] = 0.0
         ext_bend[i, 1] = 0.0
-    g0 = effects[E_GX]
-    g1 = effects[E_GY]
-    g2 = effects[E_GZ]
-    if g0 == 0.0 and g1 == 0.0 and g2 == 0.0:
-        return
     weight = params[P_RHO] * h
-    f0 = weight * g0
-    f1 = weight * g1
-    f2 = weight * g2
-    sum_f = np.zeros(3)
-    sum_pxf = np.zeros(3)
+    f0 = weight * effects[E_GX]
+    f1 = weight * effects[E_GY]
+    f2 = weight * effects[E_GZ]
+    if f0 == 0.0 and f1 == 0.0 and f2 == 0.0 and point_loads.shape[0] == 0:
+        return
+    sum_f = np.zeros(3)      # total load distal to the current element's base
+    sum_pxf = np.zeros(3)    # and its moment about the origin
     for i in range(n - 1, -1, -1):
         c0 = 0.5 * (points[i, 0] + points[i + 1, 0])
         c1 = 0.5 * (points[i, 1] + points[i + 1, 1])
         c2 = 0.5 * (points[i, 2] + points[i + 1, 2])
-        sum_f[0] += f0
-        sum_f[1] += f1
-        sum_f[2] += f2
-        sum_pxf[0] += c1 * f2 - c2 * f1
-        sum_pxf[1] += c2 * f0 - c0 * f2
-        sum_pxf[2] += c0 * f1 - c1 * f0
+        _add_load(c0, c1, c2, f0, f1, f2, sum_f, sum_pxf)
+        for m in range(point_loads.shape[0]):
+            s_load = length - point_loads[m, 3]
+            if i * h <= s_load and (s_load < (i + 1) * h or (i == n - 1 and s_load <= length)):
+                w = s_load / h - i
+                _add_load(points[i, 0] + w * (points[i + 1, 0] - points[i, 0]),
+                          points[i, 1] + w * (points[i + 1, 1] - points[i, 1]),
+                          points[i, 2] + w * (points[i + 1, 2] - points[i, 2]),
+                          point_loads[m, 0], point_loads[m, 1], point_loads[m, 2], sum_f, sum_pxf)
         p0 = points[i, 0]
         p1 = points[i, 1]
         p2 = points[i, 2]
@@ -139,6 +145,17 @@ def _element_modifiers(n, length, params, effects, tension, bend_prev, points, f
         local_y = frames[i, 0, 1] * m0 + frames[i, 1, 1] * m1 + frames[i, 2, 1] * m2
         ext_bend[i, 0] = local_y / kb
         ext_bend[i, 1] = -local_x / kb
+
+
+@kernel
+def _add_load(q0, q1, q2, f0, f1, f2, sum_f, sum_pxf):
+    """Add the force f at the point q to the running total force and its moment q x f about the origin."""
+    sum_f[0] += f0
+    sum_f[1] += f1
+    sum_f[2] += f2
+    sum_pxf[0] += q1 * f2 - q2 * f1
+    sum_pxf[1] += q2 * f0 - q0 * f2
+    sum_pxf[2] += q0 * f1 - q1 * f0
 
 
 @kernel
@@ -309,9 +326,11 @@ def _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_per_step, friction
                        slack, f0, kx, gt, gth, bend_dir):
     """Exact Dahl forces of element i after the sliding `increment`, and their derivatives.
 
-    Slack tendons get zeros. Fs = s*(Fsc + gain(theta)*T) with gain = 2 tanh(mu theta/2) (capstan_gain) and the
-    rate-friction scale s = 1 + c_rate*|v|, v = increment/dt (rate_per_step = c_rate/dt). Returns, per tendon, F0 = dahl_update(...), dF/dx, gt = dF/dFs * s*gain (own
-    tension), gth = dF/dFs * s*T*dgain/dtheta with dgain/dtheta = mu*(1 - tanh^2(mu theta/2)).
+    Slack tendons get zeros. Fs = s*(Fsc + gain(theta)*T) with gain = 2 tanh(mu theta/2)
+    (capstan_gain) and the rate-friction scale s = 1 + c_rate*|v|, v = increment/dt
+    (rate_per_step = c_rate/dt). Returns, per tendon, F0 = dahl_update(...), dF/dx,
+    gt = dF/dFs * s*gain (own tension), gth = dF/dFs * s*T*dgain/dtheta with
+    dgain/dtheta = mu*(1 - tanh^2(mu theta/2)).
     """
     theta = math.sqrt(bx * bx + by * by)
     gain = capstan_gain(mu, theta)
@@ -358,7 +377,7 @@ def make_workspace(n):
 
 
 @kernel
-def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_step, tension,
+def quasi_static_step(u, length, dt_s, params, effects, point_loads, friction, sliding, last_step, tension,
                       bend, compression, tip_tension, drive_tension, slack, points, frames, scalars, work,
                       commit_unconverged):
     """Advance the catheter state to equilibrium at tendon input u [mm] and free length [mm].
@@ -383,7 +402,7 @@ def quasi_static_step(u, length, dt_s, params, effects, friction, sliding, last_
      distal_force, distal_short, dist_force, dist_short, new_force, new_sliding, new_tension,
      new_bend, new_compression, increment, linear_force, revived, lengths, clamped, previous_increment,
      crossed, slack_before, sweep_scratch, tip_scratch) = work
-    _element_modifiers(n, length, params, effects, tension, bend, points, frames,
+    _element_modifiers(n, length, params, effects, point_loads, tension, points, frames,
                        arm, angle, rest_bend, ext_bend)
     for i in range(n):  # tendon k at phi_k = k*90 deg + twist offset
         c = math.cos(angle[i]) if angle[i] != 0.0 else 1.0
@@ -569,11 +588,12 @@ def remap_to_length(old_length, new_length, friction, sliding, last_step, tensio
 
 @kernel
 def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_step_mm, params, effects,
-             applied_tendon_mm, applied_insertion_mm, friction, sliding, last_step, tension, bend,
+             point_loads, applied_tendon_mm, applied_insertion_mm, friction, sliding, last_step, tension, bend,
              compression, tip_tension, drive_tension, slack, points, frames, scalars, tips_out):
     """Drive the model along a sampled input path; tips_out[t] is the tip after sample t.
 
     Inputs pass the drive-train plays first (backlash per tendon, tube play on insertion).
+    point_loads (K, 4): external point forces (fx, fy, fz [N], distance from the tip [mm]).
     Each sample is split into sub-steps of at most max_tendon_step_mm / max_insertion_step_mm
     so that the friction state follows the path (history) and not just its end point.
     """
@@ -606,8 +626,8 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
             previous_length = length
             length = start_length + w * (length_target - start_length)
             remap_to_length(previous_length, length, friction, sliding, last_step, tension)
-            if quasi_static_step(u, length, dt_s * fraction, params, effects, friction, sliding, last_step,
-                                 tension, bend, compression, tip_tension, drive_tension, slack, points,
+            if quasi_static_step(u, length, dt_s * fraction, params, effects, point_loads, friction, sliding,
+                                 last_step, tension, bend, compression, tip_tension, drive_tension, slack, points,
                                  frames, scalars, work, fraction <= smallest):
                 done = w
                 fraction = min(2.0 * fraction, 1.0 / n_sub)
