@@ -495,23 +495,25 @@ def quasi_static_step(u, length, dt_s, params, effects, point_loads, friction, s
                     kx[k, i] = max((f0[k, i] - friction[k, i]) / increment[k, i], 0.0)
                 # A tendon cannot be pushed: friction may at most unload the proximal half to zero,
                 # F >= -max(P, 0). Clamped at F = -P > 0 it is linear in the tension: K = 0, G = -2
-                # (T = P + F/2); at F = 0 (P <= 0) it is constant. Once clamped, an element stays
-                # clamped for the step, so Newton cannot cycle on the kink.
+                # about the point (T_ref, F0) = (P/2, -P) of that line F = -2T (T = P + F/2); at
+                # F = 0 (P <= 0) it is constant. Once clamped, an element stays clamped for the
+                # step, so Newton cannot cycle on the kink.
                 distal_tension = tip_tension[k] + distal_force[k] - linear_force[k]
                 floor = -max(distal_tension, 0.0)
+                xref[k, i] = new_sliding[k, i]
+                tref[k, i] = new_tension[k, i]
                 if not slack[k] and (f0[k, i] < floor or clamped[k, i]):
                     clamped[k, i] = True
                     f0[k, i] = floor
                     kx[k, i] = 0.0
                     gt[k, i] = -2.0 if distal_tension > 0.0 else 0.0
                     gth[k, i] = 0.0
+                    tref[k, i] = distal_tension + 0.5 * floor
                 new_force[k, i] = f0[k, i]
                 mismatch = abs(f0[k, i] - linear_force[k])
                 if not math.isfinite(mismatch):
                     finite = False
                 worst = max(worst, mismatch)
-                xref[k, i] = new_sliding[k, i]
-                tref[k, i] = new_tension[k, i]
         if finite and worst < FORCE_TOLERANCE_N:
             converged = True
             break
