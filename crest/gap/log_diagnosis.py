@@ -10,7 +10,7 @@ from pathlib import Path
 
 from crest.gap.log_recordings import load_recordings
 from model import CatheterParams
-from model.gap.calibration import ModelFit, calibrate
+from model.gap.calibration import ModelFit, calibrate_base
 from model.gap.diagnosis import DiagnosisSettings, diagnose
 
 
@@ -26,9 +26,8 @@ def calibrate_logs(train: Sequence[Path | str], catheter_toml: Path | str | None
     prior = prior_catheter(catheter_toml)
     recordings = load_recordings(train)
     say = progress or (lambda message: None)
-    return calibrate(recordings, prior, prior=prior, resolution=settings.resolution,
-                     max_iterations=settings.baseline_iterations,
-                     on_evaluation=lambda n: say(f"fit: {n} model runs") if n % 50 == 0 else None)
+    return calibrate_base(recordings, prior, resolution=settings.resolution, max_iterations=settings.baseline_iterations,
+                          on_evaluation=lambda n: say(f"fit: {n} model runs") if n % 50 == 0 else None)
 
 
 def diagnose_logs(train: Sequence[Path | str], holdout: Sequence[Path | str],

@@ -7,6 +7,10 @@ Least squares over the tip error of every valid sample of the training recording
 with the model driven by the measured tendon and insertion positions (scipy.optimize.least_squares,
 trust-region reflective, forward-difference Jacobian), warm-started from the given parameters.
 
+Between good starting parameters the cost has ridges (where a parameter change flips a tendon
+between slack and taut at some moment), so a fit can stall in a valley: `calibrate_base` explores
+several starts (`model.gap.starting_points.base_starts`) with short fits and fits the best to the end.
+
 Uncertainty from the Jacobian J at the solution (in the optimisation variables z):
 
     cov_z = s^2 (J^T J)^+,   s^2 = |r|^2 / (m - n),
@@ -21,16 +25,17 @@ import math
 import time
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import Executor
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import least_squares
 
 from model.dahl_catheter import ModelSolverError
 from model.effects.catalog import combined_terms, effect
-from model.gap.free_parameters import ParameterLayout
+from model.gap.free_parameters import ParameterLayout, base_values
 from model.gap.recording import Recording
 from model.gap.simulation import Resolution, SimulationTooSlow, catheter_for, predict_tips
+from model.gap.starting_points import base_starts
 from model.params import CatheterParams
 
 DIFF_STEP = 0.02       # relative finite-difference step: far above the kernel's ~1 um solver noise
@@ -43,9 +48,11 @@ RESTART_GAIN = 0.01
 XTOL_REACHED = 3       # least_squares status
 DIVERGED_RESIDUAL_MM = 1e3
 # Where the solver crawls (e.g. very stiff Dahl friction), a run is abandoned and scored as diverged
-# once it takes SLOW_RUN_FACTOR times as long as the run at the start (and at least MIN_TIME_LIMIT_S).
+# once it takes SLOW_RUN_FACTOR times the CPU time of the run at the start (and at least MIN_TIME_LIMIT_S).
+# CPU time, not wall time: on a busy machine a wall-clock limit would change the fit's result.
 SLOW_RUN_FACTOR = 8.0
 MIN_TIME_LIMIT_S = 0.1
+EXPLORE_ITERATIONS = 3  # cost evaluations of each start's exploratory fit (`best_start`)
 
 
 @dataclass(frozen=True)
@@ -66,7 +73,6 @@ class ModelFit:
     flags: tuple[str, ...] = ()
     train_rmse_mm: float = math.nan
     model_runs: int = 0
-    extra: dict = field(default_factory=dict)
 
     def terms(self):
         """The model's EffectTerms with the fitted effects switched on."""
@@ -85,12 +91,15 @@ class ModelFit:
         return sorted(pairs, key=lambda pair: -abs(pair[2]))
 
     def as_dict(self) -> dict:
-        """Plain JSON-able description (parameters with std, None where unidentified; correlations, flags,
-        the full catheter)."""
+        """Plain JSON-able description: base and effect parameters with std (None where not fitted or
+        unidentified), strong correlations, flags, the full catheter."""
         catheter = {name: (list(value) if isinstance(value, tuple) else value)
                     for name, value in vars(self.params).items()}
-        return {"parameters": {name: {"value": value, "std": std if math.isfinite(std) else None}
-                               for name, value, std in zip(self.names, self.values, self.std)},
+        known = {name: std for name, std in zip(self.names, self.std) if math.isfinite(std)}
+        values = base_values(self.params, self.zero_offsets_mm)
+        values.update({f"{effect_id}.{name}": value for effect_id, params in self.effect_params().items()
+                       for name, value in params.items()})
+        return {"parameters": {name: {"value": value, "std": known.get(name)} for name, value in values.items()},
                 "tendon_zero_offsets_mm": list(self.zero_offsets_mm),
                 "effects": self.effect_params(),
                 "strong_correlations": [{"a": a, "b": b, "correlation": c}
@@ -190,10 +199,10 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
             on_evaluation(runs)
 
     def residuals(z: np.ndarray) -> np.ndarray:
-        clock = time.perf_counter()
+        clock = time.process_time()
         out = objective(z)
         if objective.time_limit_s is None:   # the first run, at the start: the yardstick for a normal run
-            objective.time_limit_s = max(SLOW_RUN_FACTOR * (time.perf_counter() - clock), MIN_TIME_LIMIT_S)
+            objective.time_limit_s = max(SLOW_RUN_FACTOR * (time.process_time() - clock), MIN_TIME_LIMIT_S)
         count(out)
         last[:] = [(z.tobytes(), out)]
         return out
@@ -229,6 +238,27 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
                     names=layout.names, values=tuple(float(v) for v in physical), std=tuple(float(s) for s in std),
                     correlation=tuple(tuple(float(c) for c in row) for row in correlation), flags=flags,
                     train_rmse_mm=train_rmse, model_runs=runs)
+
+
+def best_start(recordings: Sequence[Recording], starts: Sequence[ModelFit], prior: CatheterParams,
+               resolution: Resolution, executor: Executor | None = None) -> ModelFit:
+    """The short fit (EXPLORE_ITERATIONS cost evaluations, no restarts) of each start, base parameters
+    and effects, that reaches the lowest training RMSE."""
+    explored = [calibrate(recordings, start.params, prior=prior, zero_offsets_mm=start.zero_offsets_mm,
+                          effects=start.effects, resolution=resolution, max_iterations=EXPLORE_ITERATIONS, restarts=0,
+                          executor=executor) for start in starts]
+    return min(explored, key=lambda fit: fit.train_rmse_mm)
+
+
+def calibrate_base(recordings: Sequence[Recording], prior: CatheterParams, *, resolution: Resolution = Resolution(),
+                   max_iterations: int = 30, executor: Executor | None = None,
+                   on_evaluation: Callable[[int], None] | None = None) -> ModelFit:
+    """The base model (no effects) fitted from the best of `base_starts(prior)` (see module doc)."""
+    starts = [ModelFit(params, (0.0, 0.0, 0.0, 0.0), {}) for params in base_starts(prior)]
+    start = best_start(recordings, starts, prior, resolution, executor)
+    return calibrate(recordings, start.params, prior=prior, zero_offsets_mm=start.zero_offsets_mm,
+                     resolution=resolution, max_iterations=max_iterations, executor=executor,
+                     on_evaluation=on_evaluation)
 
 
 def _statistics(jac: np.ndarray, fun: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:

@@ -5,8 +5,9 @@
 3. Which: fit every candidate effect (and a plain refit, the control) in parallel, rank them by
    held-out score (`candidates`); the best is chosen only if it removes more than noise can
    explain, else the verdict is `none` with a description of the unexplained residual. A second
-   effect is added by greedy forward selection among the next best candidates, again only if
-   it is meaningful against the control of the chosen effect refitted alone with the same budget.
+   effect is added by greedy forward selection among the next best candidates that are
+   meaningful on their own, again only if the pair is meaningful against the control: the
+   chosen effect refitted alone with the same budget.
 4. How far: held-out RMSE before and after, shrink overall and per region, and how the base
    parameters moved when the effect was added.
 The result is a plain, JSON-able dict (see `diagnose`).
@@ -22,16 +23,18 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 
 from model.effects.catalog import EFFECTS
-from model.gap.calibration import ModelFit, calibrate, rmse_mm, tip_errors
-from model.gap.candidates import (CANDIDATE_ITERATIONS, CandidateResult, FitTask, evaluate, is_meaningful, ranked,
-                                  run_tasks, start_values)
-from model.gap.free_parameters import N_BASE
+from model.gap.calibration import ModelFit, calibrate_base, rmse_mm, tip_errors
+from model.gap.candidates import (CANDIDATE_ITERATIONS, CONTINUE, EXPLORE, PROBE, CandidateResult, FitTask,
+                                  evaluate, ranked, run_tasks)
+from model.gap.free_parameters import base_values
 from model.gap.noise import tracker_noise_mm
 from model.gap.recording import Recording, RecordingError
 from model.gap.regions import breakdown, concentrated, regions, shrink_by_region
 from model.gap.sample_features import compute_features
+from model.gap.significance import is_meaningful
 from model.gap.signatures import describe, signatures
 from model.gap.simulation import Resolution, predict_tips, predict_tips_and_tension
+from model.gap.starting_points import start_values
 from model.params import CatheterParams
 
 FORMAT = "crest-gap/1"
@@ -40,7 +43,7 @@ FORMAT = "crest-gap/1"
 @dataclass(frozen=True)
 class DiagnosisSettings:
     """How the diagnosis runs. workers: parallel candidate fits; pair_candidates: how many of the
-    next best single candidates are tried as a second effect."""
+    next best single candidates are tried as a second effect (0: no pairs, single effects only)."""
 
     resolution: Resolution = Resolution()
     workers: int = 2
@@ -73,18 +76,18 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
     clock = time.perf_counter()
     timing: dict[str, float] = {}
     say(f"baseline: calibrating on {len(train)} training recording(s)")
-    baseline = calibrate(train, prior, prior=prior, resolution=res, max_iterations=settings.baseline_iterations,
-                         executor=pool,
-                         on_evaluation=lambda n: say(f"baseline: {n} model runs") if n % 50 == 0 else None)
+    baseline = calibrate_base(train, prior, resolution=res, max_iterations=settings.baseline_iterations,
+                              executor=pool,
+                              on_evaluation=lambda n: say(f"baseline: {n} model runs") if n % 50 == 0 else None)
     held = res.prepare(holdout)
     base_errors = _holdout_errors(baseline, held, res)
     base_rmse = rmse_mm(base_errors)
     noise = tracker_noise_mm(list(train) + list(holdout))
     timing["baseline"] = time.perf_counter() - clock
 
-    def task(effects: dict, start: ModelFit, explore: bool = True) -> FitTask:
+    def task(effects: dict, start: ModelFit, mode: str = EXPLORE) -> FitTask:
         return FitTask(effects, start, prior, tuple(train), tuple(held), tuple(base_errors), base_rmse, res,
-                       settings.candidate_iterations, explore)
+                       settings.candidate_iterations, mode)
 
     ids = list(settings.effects)
     say(f"candidates: fitting {len(ids)} effects and a plain refit on {settings.workers} worker(s)")
@@ -93,21 +96,33 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
                         pool, lambda r: done.append(r) or say(
                             f"candidates: {len(done)}/{len(ids) + 1} done ({'+'.join(r.effects) or 'refit'})"))
     refit, singles = results[0], results[1:]
-    if refit.fit.train_rmse_mm < baseline.train_rmse_mm:   # the control got further: it is the baseline
-        baseline, base_errors, base_rmse = refit.fit, list(refit.holdout_errors), refit.holdout_rmse_mm
-        singles = [replace(evaluate(r.effects, r.fit, r.holdout_errors, base_errors, base_rmse), seconds=r.seconds)
-                   for r in singles]
+    # The baseline is the best base-only model found: the calibration, its plain refit (the control
+    # for the candidates' extra fitting effort) or a candidate's fit with its effect switched off.
+    bases = [(baseline, base_errors), (refit.fit, list(refit.holdout_errors))] + [
+        (r.ablated(), list(r.ablated_holdout_errors)) for r in singles]
+    best_base, best_errors = min([(fit, errors) for fit, errors in bases if np.isfinite(rmse_mm(errors))],
+                                 key=lambda pair: pair[0].train_rmse_mm)
+    if best_base is not baseline:
+        say(f"baseline: improved from {baseline.train_rmse_mm:.3f} to {best_base.train_rmse_mm:.3f} mm (training)")
+        baseline, base_errors, base_rmse = best_base, best_errors, rmse_mm(best_errors)
+        singles = [replace(evaluate(r.effects, r.fit, r.holdout_errors, base_errors, base_rmse), seconds=r.seconds,
+                           ablated_train_rmse_mm=r.ablated_train_rmse_mm,
+                           ablated_holdout_errors=r.ablated_holdout_errors) for r in singles]
     singles = ranked(singles)
     timing["candidates"] = time.perf_counter() - clock - sum(timing.values())
 
     chosen: list[CandidateResult] = []
     pairs: list[CandidateResult] = []
-    if is_meaningful(base_rmse, singles[0].holdout_rmse_mm, noise):
+    if is_meaningful(base_rmse, singles[0].holdout_rmse_mm, noise) and settings.pair_candidates == 0:
+        chosen = [singles[0]]
+    elif is_meaningful(base_rmse, singles[0].holdout_rmse_mm, noise):
         best = singles[0]
-        others = [r.effects[0] for r in singles[1:1 + settings.pair_candidates]]
-        say(f"pairs: {best.effects[0]} alone (control) and with each of {', '.join(others)}")
-        continued, *pairs = run_tasks([task(dict(best.fit.effects), best.fit, explore=False)]
-                                      + [task({**best.fit.effects, other: start_values(other)}, best.fit, False)
+        # second effects: the next best singles that are meaningful on their own
+        others = [r.effects[0] for r in singles[1:] if is_meaningful(base_rmse, r.holdout_rmse_mm, noise)]
+        others = others[:settings.pair_candidates]
+        say(f"pairs: {best.effects[0]} alone (control) and with each of {', '.join(others) or 'no other'}")
+        continued, *pairs = run_tasks([task(dict(best.fit.effects), best.fit, CONTINUE)]
+                                      + [task({**best.fit.effects, other: start_values(other)}, best.fit, PROBE)
                                          for other in others], pool)
         if continued.fit.train_rmse_mm < best.fit.train_rmse_mm:   # the control got further: it is the single
             best = replace(continued, seconds=best.seconds + continued.seconds)
@@ -176,12 +191,17 @@ def _holdout_errors(fit: ModelFit, held: Sequence[Recording], res: Resolution) -
 
 
 def _base_change(before: ModelFit, after: ModelFit) -> list[dict]:
-    """How each base parameter moved when the effect was added (relative for stiffness and friction)."""
+    """How each base parameter moved when the effect was added (relative for stiffness and friction).
+
+    baseline_std: the baseline fit's standard deviation, None where it has none (e.g. a baseline
+    taken from a candidate's fit with its effect switched off).
+    """
+    std = dict(zip(before.names, before.std))
+    after_values = base_values(after.params, after.zero_offsets_mm)
     rows = []
-    for name, a, b, std in zip(before.names[:N_BASE], before.values[:N_BASE], after.values[:N_BASE],
-                               before.std[:N_BASE]):
+    for name, a in base_values(before.params, before.zero_offsets_mm).items():
+        b = after_values[name]
         rows.append({"name": name, "baseline": a, "with_effect": b, "change": b - a,
                      "relative_change": (b - a) / a if a != 0 and not name.startswith("tendon_zero") else None,
-                     "baseline_std": std if np.isfinite(std) else None})
+                     "baseline_std": std[name] if np.isfinite(std.get(name, np.nan)) else None})
     return rows
-

@@ -91,6 +91,15 @@ def base_parameters(prior: CatheterParams) -> tuple[FreeParameter, ...]:
 
 
 N_BASE = 9
+BASE_NAMES = ("bending_stiffness_nmm2", "axial_stiffness_n", "mu", "sigma_n_per_mm2", "fsc_n_per_mm") + tuple(
+    f"tendon_zero_{k + 1}_mm" for k in range(N_TENDONS))
+
+
+def base_values(params: CatheterParams, zero_offsets_mm: Sequence[float]) -> dict[str, float]:
+    """The base parameters by name (BASE_NAMES order)."""
+    values = [params.bending_stiffness_nmm2, params.axial_stiffness_n, params.mu, params.sigma_n_per_mm2,
+              params.fsc_n_per_mm, *zero_offsets_mm]
+    return dict(zip(BASE_NAMES, (float(v) for v in values)))
 
 
 def effect_parameters(effect_id: str) -> tuple[FreeParameter, ...]:
@@ -124,8 +133,7 @@ class ParameterLayout:
     def values(self, params: CatheterParams, zero_offsets_mm: Sequence[float],
                effects: Mapping[str, Sequence[float]]) -> np.ndarray:
         """Physical values in layout order."""
-        base = [params.bending_stiffness_nmm2, params.axial_stiffness_n, params.mu, params.sigma_n_per_mm2,
-                params.fsc_n_per_mm, *zero_offsets_mm] if self.fit_base else []
+        base = list(base_values(params, zero_offsets_mm).values()) if self.fit_base else []
         return np.array(base + [float(v) for effect_id in self.effect_ids for v in effects[effect_id]])
 
     def pack(self, params: CatheterParams, zero_offsets_mm: Sequence[float],

@@ -3,19 +3,22 @@ statistics and flags mean what they say."""
 import numpy as np
 import pytest
 
-from control.excitation import ExcitationGeometry, training_trajectory
+from control import MotionLimits, Workspace
+from control.excitation import training_trajectory
 from model import CatheterParams, DahlCatheter
-from model.gap.calibration import calibrate
+from model.gap.calibration import calibrate, calibrate_base
 from model.gap.free_parameters import FreeParameter
 from model.gap.recording import Recording
 from model.gap.simulation import Resolution
 
 RESOLUTION = Resolution(n_elements=6, fit_rate_hz=5.0)
+PRETENSION_MM = 0.02
 
 
 def noiseless_recording(params: CatheterParams, zeros_mm=(0.0, 0.0, 0.0, 0.0)) -> Recording:
     """Tips of the model itself (same resolution as the fit) along the short training excitation."""
-    trajectory = training_trajectory(ExcitationGeometry.from_params(params), RESOLUTION.fit_rate_hz, short=True)
+    trajectory = training_trajectory(Workspace.from_params(params, pretension_mm=PRETENSION_MM), MotionLimits(),
+                                     1.0 / RESOLUTION.fit_rate_hz, short=True)
     model = DahlCatheter(params, RESOLUTION.n_elements, max_tendon_step_mm=RESOLUTION.max_tendon_step_mm,
                          max_insertion_step_mm=RESOLUTION.max_insertion_step_mm)
     tips = model.run(trajectory.tendon_mm - np.asarray(zeros_mm), trajectory.insertion_mm,
@@ -28,7 +31,7 @@ def test_calibration_recovers_known_parameters_from_noiseless_data():
     prior = CatheterParams.from_toml()
     truth = prior.replace(bending_stiffness_nmm2=1150.0, mu=0.26, sigma_n_per_mm2=0.7, fsc_n_per_mm=0.0065)
     zeros = (0.002, -0.001, 0.0, 0.001)
-    fit = calibrate([noiseless_recording(truth, zeros)], prior, resolution=RESOLUTION, max_iterations=40)
+    fit = calibrate_base([noiseless_recording(truth, zeros)], prior, resolution=RESOLUTION, max_iterations=40)
     assert fit.train_rmse_mm < 0.05          # from several mm at the prior
     assert fit.params.bending_stiffness_nmm2 == pytest.approx(1150.0, rel=0.1)
     assert fit.params.mu == pytest.approx(0.26, abs=0.03)

@@ -1,0 +1,33 @@
+"""When is a smaller held-out error a found effect, and not noise or fitting freedom?
+
+The held-out tip RMSE of a model is at best the tracker noise floor f = sqrt(3) sigma (sigma
+per axis, `model.gap.noise`). An added effect must remove a part of the error above that
+floor that no amount of refitting noise could: see `is_meaningful`.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+MIN_SHRINK = 0.03                 # at least 3 % of the held-out RMSE ...
+MIN_SHRINK_WITHOUT_NOISE = 0.05   # ... or 5 % when the noise floor is unknown
+MIN_GAIN_OVER_NOISE = 0.1         # ... and at least 10 % of the noise variance 3 sigma^2 (mm^2)
+MIN_EXCESS_FRACTION = 0.25        # ... and a quarter of the squared error above the noise floor
+
+
+def is_meaningful(rmse_before_mm: float, rmse_after_mm: float, noise_mm: float | None) -> bool:
+    """Does going from before to after remove more error than noise and fitting freedom explain?
+
+    With the noise floor f^2 = 3 sigma^2 (sigma per axis) the gain g = before^2 - after^2 must
+    reach MIN_GAIN_OVER_NOISE * f^2 and MIN_EXCESS_FRACTION of the excess before^2 - f^2 (the part
+    of the error a model could remove at all), and the shrink 1 - after/before MIN_SHRINK.
+    Without a noise estimate: shrink >= MIN_SHRINK_WITHOUT_NOISE.
+    """
+    if not (rmse_before_mm > 0 and np.isfinite(rmse_after_mm)):
+        return False
+    shrink = 1.0 - rmse_after_mm / rmse_before_mm
+    if noise_mm is None:
+        return shrink >= MIN_SHRINK_WITHOUT_NOISE
+    floor = 3.0 * noise_mm ** 2
+    gain = rmse_before_mm ** 2 - rmse_after_mm ** 2
+    return shrink >= MIN_SHRINK and gain >= max(MIN_GAIN_OVER_NOISE * floor,
+                                                MIN_EXCESS_FRACTION * (rmse_before_mm ** 2 - floor))
