@@ -66,20 +66,29 @@ class Recording:
         return float(np.median(np.diff(self.t_s)))
 
     def decimated(self, factor: int) -> "Recording":
-        """Every `factor`-th sample (factor 1 returns self).
+        """About every `factor`-th sample: from each block of `factor` samples the first one with a tip
+        (the block's first when none has one). Factor 1 returns self.
 
-        The model interpolates the input linearly between kept samples, so decimation is
-        harmless as long as the input path is smooth on the scale of `factor` samples.
+        A log written at the control rate holds the tracker's slower frames (rows between them
+        have no tip), and the tracker drops frames; picking the first measured row of each block
+        keeps a tip in every block that has one. The model interpolates the input linearly
+        between kept samples, so decimation is harmless as long as the input path is smooth on
+        the scale of `factor` samples.
         """
         if factor <= 1:
             return self
-        return self._subset(slice(None, None, int(factor)))
+        valid = self.valid
+        keep = []
+        for start in range(0, len(self), int(factor)):
+            block = valid[start:start + int(factor)]
+            keep.append(start + int(np.argmax(block)) if block.any() else start)
+        return self._subset(np.array(keep))
 
     def head(self, count: int) -> "Recording":
         """The first `count` samples."""
         return self if count >= len(self) else self._subset(slice(0, int(count)))
 
-    def _subset(self, keep: slice) -> "Recording":
+    def _subset(self, keep: slice | np.ndarray) -> "Recording":
         force = None if self.tendon_force_n is None else self.tendon_force_n[keep]
         return Recording(self.name, self.t_s[keep], self.tendon_mm[keep], self.insertion_mm[keep],
                          self.tip_mm[keep], force, self.flexible_length_mm, self.tendon_offset_mm,
