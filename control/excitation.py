@@ -1,9 +1,9 @@
 """Excitation trajectories for calibration and gap diagnosis (`crest excite`).
 
-Each trajectory is a sampled set-point path: tendon displacements [T, 4] (mm, positive =
-pulled) and free length [T] (mm). It is written in articulation coordinates, the bend vector
-b = theta * (cos phi, sin phi) [rad] of the whole catheter and the free length L, and mapped
-to tendons by the constant-curvature inverse (model.constant_curvature):
+Each is a `control.trajectories.Trajectory`: set-points in articulation coordinates, the bend
+vector b = theta * (cos phi, sin phi) [rad] of the whole catheter and the free length L [mm],
+checked against the workspace and the motion limits before anything runs. The testbed follows
+them with the constant-curvature inverse (`Trajectory.tendon_mm`):
 
     u_k = r * (b_x cos phi_k + b_y sin phi_k) + pretension,   phi_k = (k - 1) * 90 deg.
 
@@ -15,177 +15,145 @@ The primitives each expose one effect's signature:
   precurvature, which all scale with free length);
 - circles in both directions (out-of-plane coupling, direction dependence);
 - static holds (bias at rest: tracker offset, gravity; rate effects vanish there).
-Transitions are raised cosines, so the path is smooth: its set-points can be followed by
-drives with acceleration limits and decimated for fitting without losing reversals.
+Every primitive starts and ends at rest: moves are trapezoids within the limits, sweeps and
+minor loops are cosines theta = c + a cos(2 pi f t) that begin at a turning point, and circles
+turn their plane on a trapezoid. So the drives can follow the set-points as they are (no
+slowing down), and decimating them for fitting loses no reversal.
 Training and held-out trajectories use different planes, amplitudes and speeds.
+
+The model starts every recording from the straight state with no friction stored along the
+catheter. A catheter that has moved before stores friction (hysteresis) even when straight, so
+each excitation is preceded, unrecorded, by `conditioning_trajectory`: a spiral in bend space
+whose articulation decays to zero, which erases the friction memory the way a decaying
+alternating field demagnetises iron (in the model, a catheter run through the training
+excitation and then this spiral follows the held-out excitation within 0.05 mm RMS of a fresh
+one; without it, 0.5 mm RMS and 1.4 mm in its first 10 s).
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
-from model.constant_curvature import TENDON_ANGLES_RAD
-from model.params import CatheterParams
+from control.motion_limits import MotionLimits
+from control.trajectories import Trajectory
+from control.trajectories.path_builder import PathBuilder
+from control.trajectories.trapezoid import trapezoid_samples
+from control.workspace import Workspace
+
+CONDITIONING_DEG = 100.0         # the spiral's first articulation ...
+CONDITIONING_TURNS = 10          # ... decaying to zero over this many turns ...
+CONDITIONING_PERIOD_S = 3.0      # ... of this period
+MOVE_VELOCITY_RAD_S = 1.2        # articulation moves between primitives
+MOVE_ACCELERATION_RAD_S2 = 2.0
+INSERTION_ACCELERATION_MM_S2 = 20.0
 
 
-@dataclass(frozen=True)
-class ExcitationGeometry:
-    """What the trajectories need to know about the catheter (mm)."""
-
-    tendon_offset_mm: float
-    free_length_mm: float
-    min_free_length_mm: float
-    max_free_length_mm: float
-    pretension_mm: float = 0.02
-
-    @classmethod
-    def from_params(cls, params: CatheterParams, pretension_mm: float = 0.02) -> "ExcitationGeometry":
-        return cls(params.tendon_offset_mm, params.free_length_mm, params.min_free_length_mm,
-                   params.max_free_length_mm, pretension_mm)
-
-    def insertion_range_mm(self) -> tuple[float, float]:
-        """The free-length excursion: 30 % below to 15 % above nominal, inside the limits."""
-        return (max(self.min_free_length_mm, 0.7 * self.free_length_mm),
-                min(self.max_free_length_mm, 1.15 * self.free_length_mm))
+def _direction(plane_deg: float) -> np.ndarray:
+    return np.array([math.cos(math.radians(plane_deg)), math.sin(math.radians(plane_deg))])
 
 
-@dataclass(frozen=True)
-class Segment:
-    """A named part of a trajectory over [start_s, stop_s)."""
+class _Excitation:
+    """Appends the excitation primitives to a PathBuilder, each starting where the last ended."""
 
-    label: str
-    start_s: float
-    stop_s: float
+    def __init__(self, workspace: Workspace, limits: MotionLimits, period_s: float):
+        self.workspace = workspace
+        self.path = PathBuilder(workspace, limits, period_s, workspace.home)
 
+    def _times(self, duration_s: float) -> np.ndarray:
+        """T, 2T, ..., duration_s: the samples of a primitive after its start."""
+        period = self.path.period_s
+        return period * np.arange(1, max(1, round(duration_s / period)) + 1)
 
-@dataclass(frozen=True)
-class Trajectory:
-    """Set-points over time: t_s [T], tendon_mm [T, 4], insertion_mm [T] (free length)."""
+    def hold(self, duration_s: float) -> None:
+        self.path.hold(duration_s, "static hold")
 
-    name: str
-    t_s: np.ndarray
-    tendon_mm: np.ndarray
-    insertion_mm: np.ndarray
-    segments: tuple[Segment, ...]
+    def move(self, bend_deg: float, plane_deg: float, free_length_mm: float | None = None,
+             label: str = "move", insertion_velocity_mm_s: float | None = None) -> None:
+        """A trapezoidal move to articulation (bend, plane) and free length (default: unchanged)."""
+        length = self.path.insertion_mm if free_length_mm is None else free_length_mm
+        self.path.line(math.radians(bend_deg) * _direction(plane_deg), length, label,
+                       bend_velocity_rad_s=MOVE_VELOCITY_RAD_S, bend_acceleration_rad_s2=MOVE_ACCELERATION_RAD_S2,
+                       insertion_velocity_mm_s=insertion_velocity_mm_s,
+                       insertion_acceleration_mm_s2=INSERTION_ACCELERATION_MM_S2)
 
-    @property
-    def duration_s(self) -> float:
-        return float(self.t_s[-1] - self.t_s[0])
-
-    def repeated(self, duration_s: float) -> "Trajectory":
-        """This trajectory played back to back until it lasts at least duration_s (e.g. for benchmarks)."""
-        count = max(1, math.ceil(duration_s / (self.duration_s + self.t_s[1] - self.t_s[0])))
-        dt = self.t_s[1] - self.t_s[0]
-        n = len(self.t_s)
-        t = np.arange(n * count) * dt
-        return Trajectory(f"{self.name} x{count}", t, np.tile(self.tendon_mm, (count, 1)),
-                          np.tile(self.insertion_mm, count), self.segments)
-
-
-class _Builder:
-    """Appends smooth articulation segments sampled at a fixed rate."""
-
-    def __init__(self, geometry: ExcitationGeometry, sample_rate_hz: float):
-        if not sample_rate_hz > 0:
-            raise ValueError(f"sample_rate_hz must be > 0, got {sample_rate_hz!r}")
-        self.geometry = geometry
-        self.dt_s = 1.0 / sample_rate_hz
-        self.bend = [np.zeros((1, 2))]
-        self.length = [np.array([geometry.free_length_mm])]
-        self.segments: list[Segment] = []
-        self.time_s = 0.0
-
-    @property
-    def current(self) -> tuple[np.ndarray, float]:
-        return self.bend[-1][-1].copy(), float(self.length[-1][-1])
-
-    def _append(self, label: str, bend: np.ndarray, length: np.ndarray) -> None:
-        self.bend.append(bend)
-        self.length.append(length)
-        duration = len(length) * self.dt_s
-        self.segments.append(Segment(label, self.time_s, self.time_s + duration))
-        self.time_s += duration
-
-    def _time(self, duration_s: float) -> np.ndarray:
-        """Local times of a segment: dt, 2 dt, ..., duration (the start sample is the previous end)."""
-        return np.arange(1, max(1, round(duration_s / self.dt_s)) + 1) * self.dt_s
-
-    def hold(self, duration_s: float, label: str = "static hold") -> None:
-        bend, length = self.current
-        n = len(self._time(duration_s))
-        self._append(label, np.tile(bend, (n, 1)), np.full(n, length))
-
-    def move(self, bend_deg: float, plane_deg: float, duration_s: float, free_length_mm: float | None = None,
-             label: str = "move") -> None:
-        """Raised-cosine transition to articulation (bend, plane) and free length."""
-        start_bend, start_length = self.current
-        target = math.radians(bend_deg) * np.array([math.cos(math.radians(plane_deg)),
-                                                    math.sin(math.radians(plane_deg))])
-        end_length = start_length if free_length_mm is None else free_length_mm
-        t = self._time(duration_s)
-        w = 0.5 - 0.5 * np.cos(np.pi * t / t[-1])
-        self._append(label, start_bend + w[:, None] * (target - start_bend), start_length + w * (end_length - start_length))
+    def _oscillate(self, label: str, plane_deg: float, centre_deg: float, amplitude_deg: float,
+                   frequency_hz: float, cycles: int) -> None:
+        """theta = centre + amplitude cos(2 pi f t) in one plane, from its turning point centre + amplitude."""
+        self.move(centre_deg + amplitude_deg, plane_deg)
+        t = self._times(cycles / frequency_hz)
+        theta = math.radians(centre_deg) + math.radians(amplitude_deg) * np.cos(2 * np.pi * frequency_hz * t)
+        self.path.samples(theta[:, None] * _direction(plane_deg), np.full(len(t), self.path.insertion_mm), label)
 
     def sweep(self, plane_deg: float, amplitude_deg: float, frequency_hz: float, cycles: int) -> None:
-        """theta = A sin(2 pi f t) in one plane, through straight to both sides (starts straight)."""
-        self.move(0.0, plane_deg, 1.0)
-        _, length = self.current
-        t = self._time(cycles / frequency_hz)
-        theta = math.radians(amplitude_deg) * np.sin(2 * np.pi * frequency_hz * t)
-        direction = np.array([math.cos(math.radians(plane_deg)), math.sin(math.radians(plane_deg))])
-        self._append(f"sweep plane {plane_deg:g} deg, {amplitude_deg:g} deg at {frequency_hz:g} Hz",
-                     theta[:, None] * direction, np.full(len(t), length))
+        """Through straight to both sides: theta = A cos(2 pi f t) in one plane."""
+        self._oscillate(f"sweep plane {plane_deg:g} deg, {amplitude_deg:g} deg at {frequency_hz:g} Hz", plane_deg,
+                        0.0, amplitude_deg, frequency_hz, cycles)
 
     def minor_loops(self, plane_deg: float, centre_deg: float, amplitude_deg: float, frequency_hz: float,
                     cycles: int) -> None:
-        """Reversals: theta = centre + a sin(2 pi f t) about a bent pose."""
-        self.move(centre_deg, plane_deg, 2.0)
-        _, length = self.current
-        t = self._time(cycles / frequency_hz)
-        theta = math.radians(centre_deg) + math.radians(amplitude_deg) * np.sin(2 * np.pi * frequency_hz * t)
-        direction = np.array([math.cos(math.radians(plane_deg)), math.sin(math.radians(plane_deg))])
-        self._append(f"minor loops at {centre_deg:g} deg +-{amplitude_deg:g} deg", theta[:, None] * direction,
-                     np.full(len(t), length))
+        """Reversals about a bent pose: theta = centre + a cos(2 pi f t)."""
+        self._oscillate(f"minor loops at {centre_deg:g} deg +-{amplitude_deg:g} deg", plane_deg, centre_deg,
+                        amplitude_deg, frequency_hz, cycles)
 
     def circle(self, bend_deg: float, start_plane_deg: float, turns: float, period_s: float) -> None:
-        """Constant articulation while the plane turns (turns > 0: counter-clockwise seen from the tip)."""
-        self.move(bend_deg, start_plane_deg, 2.0)
-        _, length = self.current
-        t = self._time(abs(turns) * period_s)
-        phi = math.radians(start_plane_deg) + math.copysign(2 * np.pi, turns) * t / period_s
-        theta = math.radians(bend_deg)
-        self._append(f"circle at {bend_deg:g} deg, {'ccw' if turns > 0 else 'cw'}",
-                     theta * np.stack([np.cos(phi), np.sin(phi)], axis=1), np.full(len(t), length))
+        """Constant articulation while the plane turns (turns > 0: counter-clockwise seen from the tip).
+
+        The plane angle runs on a trapezoid up to omega = 2 pi / period_s with acceleration
+        omega^2 / pi (a quarter turn to reach full speed), as `control.trajectories.circle`.
+        """
+        self.move(bend_deg, start_plane_deg)
+        omega = 2 * np.pi / period_s
+        turned = trapezoid_samples(2 * np.pi * abs(turns), omega, omega ** 2 / np.pi, self.path.period_s)
+        phi = math.radians(start_plane_deg) + math.copysign(1.0, turns) * turned
+        self.path.samples(math.radians(bend_deg) * np.column_stack([np.cos(phi), np.sin(phi)]),
+                          np.full(len(phi), self.path.insertion_mm),
+                          f"circle at {bend_deg:g} deg, {'ccw' if turns > 0 else 'cw'}")
 
     def insertion_cycle(self, bend_deg: float, plane_deg: float, speed_mm_s: float, hold_s: float = 1.5) -> None:
         """At constant articulation: free length nominal -> longest -> shortest -> nominal, with holds.
 
-        speed_mm_s is the mean speed of each change; the raised cosine peaks at pi/2 times it.
+        The free-length excursion is 30 % below to 15 % above nominal (inside the workspace);
+        speed_mm_s is the peak speed of each change.
         """
-        self.move(bend_deg, plane_deg, 2.0, label="move")
-        low, high = self.geometry.insertion_range_mm()
-        nominal = self.geometry.free_length_mm
+        self.move(bend_deg, plane_deg)
+        nominal = self.workspace.home_insertion_mm
+        low = max(self.workspace.min_insertion_mm, 0.7 * nominal)
+        high = min(self.workspace.max_insertion_mm, 1.15 * nominal)
         for target in (high, low, nominal):
-            _, length = self.current
-            self.move(bend_deg, plane_deg, max(1.0, abs(target - length) / speed_mm_s), target,
-                      label=f"insertion change at {bend_deg:g} deg")
+            self.move(bend_deg, plane_deg, target, label=f"insertion change at {bend_deg:g} deg",
+                      insertion_velocity_mm_s=speed_mm_s)
             self.hold(hold_s)
 
-    def trajectory(self, name: str) -> Trajectory:
-        bend = np.concatenate(self.bend)
-        length = np.concatenate(self.length)
-        g = self.geometry
-        tendon = g.tendon_offset_mm * (bend[:, :1] * np.cos(TENDON_ANGLES_RAD) + bend[:, 1:] * np.sin(TENDON_ANGLES_RAD))
-        return Trajectory(name, np.arange(len(length)) * self.dt_s, tendon + g.pretension_mm, length,
-                          tuple(self.segments))
+    def trajectory(self) -> Trajectory:
+        self.move(0.0, 0.0)
+        self.hold(3.0)
+        return self.path.build()
 
 
-def training_trajectory(geometry: ExcitationGeometry, sample_rate_hz: float = 100.0,
+def conditioning_trajectory(workspace: Workspace, limits: MotionLimits = MotionLimits(),
+                            period_s: float = 0.01) -> Trajectory:
+    """The friction-erasing spiral (see module doc) from straight at the home free length, back to it.
+
+    b(t) = theta(t) (cos psi, sin psi), psi = 2 pi t / P, theta = A min(1, t/P) (1 - t/(n P)):
+    the articulation ramps in over the first turn and decays linearly to zero over n turns.
+    """
+    path = PathBuilder(workspace, limits, period_s, workspace.home)
+    duration_s = CONDITIONING_TURNS * CONDITIONING_PERIOD_S
+    t = period_s * np.arange(1, round(duration_s / period_s) + 1)
+    theta = math.radians(CONDITIONING_DEG) * np.minimum(1.0, t / CONDITIONING_PERIOD_S) * (1.0 - t / duration_s)
+    psi = 2 * np.pi * t / CONDITIONING_PERIOD_S
+    path.samples(theta[:, None] * np.column_stack([np.cos(psi), np.sin(psi)]), np.full(len(t), path.insertion_mm),
+                 "conditioning spiral")
+    path.hold(1.0, "static hold")
+    return path.build()
+
+
+def training_trajectory(workspace: Workspace, limits: MotionLimits = MotionLimits(), period_s: float = 0.01,
                         short: bool = False) -> Trajectory:
-    """The calibration/training excitation (about 230 s; `short`: one of each primitive, about 75 s)."""
-    b = _Builder(geometry, sample_rate_hz)
+    """The calibration/training excitation from straight at the home free length (about 250 s;
+    `short`: one of each primitive, about 90 s), sampled every period_s."""
+    b = _Excitation(workspace, limits, period_s)
     b.hold(3.0)
     if short:
         b.sweep(0.0, 100.0, 0.1, 1)
@@ -193,7 +161,7 @@ def training_trajectory(geometry: ExcitationGeometry, sample_rate_hz: float = 10
         b.sweep(90.0, 70.0, 0.2, 1)
         b.minor_loops(0.0, 70.0, 20.0, 0.3, 2)
         b.hold(2.0)
-        b.move(90.0, 45.0, 2.0)
+        b.move(90.0, 45.0)
         b.hold(2.0)
         b.insertion_cycle(0.0, 0.0, 6.0, hold_s=1.0)
         b.insertion_cycle(60.0, 300.0, 6.0, hold_s=1.0)
@@ -211,22 +179,20 @@ def training_trajectory(geometry: ExcitationGeometry, sample_rate_hz: float = 10
         b.minor_loops(270.0, 60.0, 15.0, 0.4, 3)
         b.hold(2.0)
         for bend_deg, plane_deg in ((120.0, 30.0), (60.0, 200.0), (0.0, 0.0)):
-            b.move(bend_deg, plane_deg, 2.5)
+            b.move(bend_deg, plane_deg)
             b.hold(3.0)
         b.insertion_cycle(0.0, 0.0, 5.0)
         b.insertion_cycle(70.0, 300.0, 5.0)
         b.circle(60.0, 0.0, 1.0, 10.0)
         b.circle(60.0, 0.0, -1.0, 10.0)
         b.circle(110.0, 90.0, 1.0, 14.0)
-    b.move(0.0, 0.0, 2.0)
-    b.hold(3.0)
-    return b.trajectory("training (short)" if short else "training")
+    return b.trajectory()
 
 
-def holdout_trajectory(geometry: ExcitationGeometry, sample_rate_hz: float = 100.0,
+def holdout_trajectory(workspace: Workspace, limits: MotionLimits = MotionLimits(), period_s: float = 0.01,
                        short: bool = False) -> Trajectory:
-    """The held-out excitation: other planes, amplitudes and speeds (about 130 s; `short`: about 50 s)."""
-    b = _Builder(geometry, sample_rate_hz)
+    """The held-out excitation: other planes, amplitudes and speeds (about 140 s; `short`: about 60 s)."""
+    b = _Excitation(workspace, limits, period_s)
     b.hold(3.0)
     if short:
         b.sweep(20.0, 85.0, 0.15, 1)
@@ -242,12 +208,10 @@ def holdout_trajectory(geometry: ExcitationGeometry, sample_rate_hz: float = 100
         b.sweep(250.0, 95.0, 0.3, 2)
         b.minor_loops(200.0, 100.0, 25.0, 0.3, 3)
         b.hold(2.0)
-        b.move(90.0, 300.0, 2.5)
+        b.move(90.0, 300.0)
         b.hold(3.0)
         b.insertion_cycle(0.0, 0.0, 6.0)
         b.insertion_cycle(50.0, 160.0, 6.0)
         b.circle(85.0, 45.0, -1.0, 9.0)
         b.circle(85.0, 45.0, 1.0, 9.0)
-    b.move(0.0, 0.0, 2.0)
-    b.hold(3.0)
-    return b.trajectory("held-out (short)" if short else "held-out")
+    return b.trajectory()

@@ -4,8 +4,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
 from control import Articulation, MotionLimits, Workspace
 from control.trajectories import (Trajectory, articulation_sweep, circle, history_scenario,
                                   insertion_at_articulation)
@@ -37,10 +35,7 @@ def builtin_trajectory(name: str, workspace: Workspace, limits: MotionLimits, op
                                  velocity_rad_s=ARTICULATION_VELOCITY_RAD_S,
                                  acceleration_rad_s2=ARTICULATION_ACCELERATION_RAD_S2, hold_s=0.5, back=True,
                                  **common)
-        repeats = max(1, round(options.periods))
-        labels = [f"{label} {k + 1}" for k in range(repeats) for label in one.labels]
-        return Trajectory(np.tile(one.bend_rad, (repeats, 1)), np.tile(one.insertion_mm, repeats), labels,
-                          start, workspace, limits, period_s)
+        return one.repeated(max(1, round(options.periods)))
     if name == "circle":
         return circle(workspace, limits, articulation_rad=theta, circle_period_s=options.circle_period_s,
                       turns=options.periods, start_plane_rad=plane, insertion_mm=options.insertion_mm,

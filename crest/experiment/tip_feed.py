@@ -7,7 +7,9 @@ cycle of the 40 Hz tracker). `age_s` is the loop time since the last valid tip.
 
 In simulated time (`sample_period_s` given) the loop runs faster than the wall-clock tracker, so
 the feed asks for a fresh frame once per tracker period of simulated time and waits for it:
-the samples then describe the simulated catheter at that instant, as a real tracker would.
+the samples then describe the simulated catheter at that instant, as a real tracker would. The
+first frame to arrive may have been requested before the last cycle (the tracker thread polls
+on its own), so the feed waits for the one after it.
 """
 from __future__ import annotations
 
@@ -44,6 +46,7 @@ class TipFeed:
         else:
             self._next_sample_s = now_s + self.sample_period_s
             try:
+                self.tracker.wait_next(FRESH_SAMPLE_TIMEOUT_S)        # possibly requested before now
                 sample = self.tracker.wait_next(FRESH_SAMPLE_TIMEOUT_S)
             except TimeoutError:       # the link is down: the age keeps growing
                 return None

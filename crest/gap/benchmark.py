@@ -6,6 +6,7 @@ both logs and the whole diagnosis (baseline, all candidates in parallel, pairs, 
 """
 from __future__ import annotations
 
+import math
 import os
 import tempfile
 import time
@@ -13,7 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
-from control.excitation import ExcitationGeometry, holdout_trajectory, training_trajectory
+from control.excitation import holdout_trajectory, training_trajectory
+from crest.config import load_testbed_config
+from crest.experiment.workspace_from_config import limits_for, workspace_for
 from crest.gap.log_diagnosis import diagnose_logs
 from crest.gap.synthetic_logs import Plant, SensorNoise, record_plant_log
 from model import CatheterParams
@@ -26,14 +29,15 @@ def diagnosis_time(duration_s: float = 600.0, sample_rate_hz: float = 100.0, wor
                    seed: int = 0) -> dict:
     """Seconds to diagnose a `duration_s` training log plus the standard held-out log, with the verdict."""
     params = CatheterParams.from_toml()
-    geometry = ExcitationGeometry.from_params(params)
+    config = load_testbed_config()
+    workspace, limits, period_s = workspace_for(config, params), limits_for(config), 1.0 / sample_rate_hz
+    one = training_trajectory(workspace, limits, period_s)
     plant = Plant(params.replace(mu=0.25), {"backlash": (0.4,)})
     rng = np.random.default_rng(seed)
     with tempfile.TemporaryDirectory(prefix="crest-gap-bench-") as folder:
-        train = record_plant_log(Path(folder) / "train.csv",
-                                 training_trajectory(geometry, sample_rate_hz).repeated(duration_s), plant,
-                                 SensorNoise(), rng)
-        holdout = record_plant_log(Path(folder) / "holdout.csv", holdout_trajectory(geometry, sample_rate_hz),
+        train = record_plant_log(Path(folder) / "train.csv", one.repeated(math.ceil(duration_s / one.duration_s)),
+                                 plant, SensorNoise(), rng)
+        holdout = record_plant_log(Path(folder) / "holdout.csv", holdout_trajectory(workspace, limits, period_s),
                                    plant, SensorNoise(), rng)
         start = time.perf_counter()
         result = diagnose_logs([train], [holdout], settings=DiagnosisSettings(workers=workers))

@@ -1,9 +1,10 @@
-"""Record crest logs from a model plant: the stand-in for `crest excite` on the virtual testbed.
+"""Record crest logs from a model plant directly: a fast stand-in for `crest excite` on the
+virtual testbed, for the tests and `crest bench` (the blind benchmark uses the testbed itself).
 
 The plant is a fine DahlCatheter (20 elements) with its own base parameters, tendon zero
-offsets and any candidate effects switched on. The drives follow the set-points exactly and
-report them; the tracker adds Gaussian noise and drops samples; the drive tension is reported
-with noise. The log records only what a testbed would: which
+offsets and any candidate effects switched on. The drives follow the constant-curvature
+set-points exactly and report them; the tracker adds Gaussian noise and drops samples; the
+drive tension is reported with noise. The log records only what a testbed would: which
 effect the plant has is never written (the sidecar says "model plant", nothing more).
 """
 from __future__ import annotations
@@ -14,10 +15,11 @@ from pathlib import Path
 
 import numpy as np
 
-from control.excitation import Trajectory
+from control.trajectories import Trajectory
 from crest.log import LogWriter, catheter_dict
 from model import CatheterParams, DahlCatheter
 from model.effects import combined_terms
+
 
 @dataclass(frozen=True)
 class SensorNoise:
@@ -40,14 +42,15 @@ class Plant:
 
 def record_plant_log(path: Path | str, trajectory: Trajectory, plant: Plant, noise: SensorNoise,
                      rng: np.random.Generator, *, overwrite: bool = False) -> Path:
-    """Drive the plant along the trajectory and write what the testbed would log; returns the CSV path."""
+    """Drive the plant along the trajectory's constant-curvature tendon commands and write what the
+    testbed would log; returns the CSV path."""
     tendon_pos = trajectory.tendon_mm
     insertion_pos = trajectory.insertion_mm
     params = plant.params.replace(free_length_mm=float(insertion_pos[0]))
     catheter = DahlCatheter(params, plant.n_elements, combined_terms(plant.effects))
     u = tendon_pos - np.asarray(plant.zero_offsets_mm)
-    dt_s = float(trajectory.t_s[1] - trajectory.t_s[0])
-    n = len(trajectory.t_s)
+    dt_s = trajectory.period_s
+    n = len(trajectory)
     tips = np.empty((n, 3))
     force = np.empty((n, 4))
     for t in range(n):
@@ -60,8 +63,8 @@ def record_plant_log(path: Path | str, trajectory: Trajectory, plant: Plant, noi
                                      tendon_offset_mm=plant.params.tendon_offset_mm,
                                      outer_diameter_mm=plant.params.outer_diameter_mm)
     with LogWriter(path, catheter=sidecar_catheter, sample_rate_hz=1.0 / dt_s, source="model plant",
-                   notes=f"excitation: {trajectory.name}", tendon_force=True, overwrite=overwrite) as writer:
+                   notes="excitation", tendon_force=True, overwrite=overwrite) as writer:
         for t in range(n):
-            writer.write(trajectory.t_s[t], trajectory.tendon_mm[t], trajectory.insertion_mm[t], tendon_pos[t],
+            writer.write(trajectory.t_s[t] - trajectory.t_s[0], tendon_pos[t], insertion_pos[t], tendon_pos[t],
                          insertion_pos[t], None if np.isnan(tips[t, 0]) else tips[t], tendon_force_n=force[t])
     return writer.path

@@ -7,7 +7,9 @@ from pathlib import Path
 
 import numpy as np
 
-from control.excitation import ExcitationGeometry, holdout_trajectory, training_trajectory
+from control.excitation import holdout_trajectory, training_trajectory
+from crest.config import load_testbed_config
+from crest.experiment.workspace_from_config import limits_for, workspace_for
 from crest.gap.log_diagnosis import diagnose_logs
 from crest.gap.synthetic_logs import Plant, SensorNoise, record_plant_log
 from model import CatheterParams
@@ -30,14 +32,15 @@ def prior() -> CatheterParams:
 def record_case(folder: Path, effects: dict, seed: int = 1, noise_mm: float = 0.1) -> tuple[Path, Path]:
     """Training and held-out logs of a plant with `effects` ({id: values}, typical values for None)."""
     params = prior()
-    geometry = ExcitationGeometry.from_params(params)
+    config = load_testbed_config()
+    workspace, limits, period_s = workspace_for(config, params), limits_for(config), 1.0 / SAMPLE_RATE_HZ
     plant = Plant(params.replace(**PLANT_CHANGES),
                   {e: EFFECTS[e].typical if v is None else v for e, v in effects.items()}, n_elements=10)
     rng = np.random.default_rng(seed)
     noise = SensorNoise(tip_mm=noise_mm, dropout_fraction=0.01)
-    train = record_plant_log(folder / "train.csv", training_trajectory(geometry, SAMPLE_RATE_HZ, short=True), plant,
-                             noise, rng)
-    holdout = record_plant_log(folder / "holdout.csv", holdout_trajectory(geometry, SAMPLE_RATE_HZ, short=True),
+    train = record_plant_log(folder / "train.csv", training_trajectory(workspace, limits, period_s, short=True),
+                             plant, noise, rng)
+    holdout = record_plant_log(folder / "holdout.csv", holdout_trajectory(workspace, limits, period_s, short=True),
                                plant, noise, rng)
     return train, holdout
 

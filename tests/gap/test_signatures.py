@@ -2,12 +2,15 @@
 import numpy as np
 import pytest
 
-from control.excitation import ExcitationGeometry, training_trajectory
+from control import MotionLimits, Workspace
+from control.excitation import training_trajectory
 from model import CatheterParams, DahlCatheter
 from model.effects import combined_terms
 from model.gap.noise import tracker_noise_mm
 from model.gap.recording import Recording
 from model.gap.signatures import _dead_band
+
+PRETENSION_MM = 0.02
 
 
 def recording(t, tendon, tip, insertion=80.0):
@@ -25,7 +28,8 @@ def test_noise_floor_from_static_holds_is_the_tracker_noise():
 def test_play_in_the_drive_train_shows_as_a_dead_band_of_its_width():
     """With backlash w the tip does not move for about w of tendon travel after each reversal."""
     params = CatheterParams.from_toml()
-    trajectory = training_trajectory(ExcitationGeometry.from_params(params), 20.0, short=True)
+    trajectory = training_trajectory(Workspace.from_params(params, pretension_mm=PRETENSION_MM), MotionLimits(), 0.05,
+                                     short=True)
     tips = {}
     for width_mm in (0.0, 0.6):
         model = DahlCatheter(params, 6, combined_terms({"backlash": (width_mm,)}))
