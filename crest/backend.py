@@ -9,6 +9,7 @@ import itertools
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import can
 
@@ -52,19 +53,21 @@ class Backend:
             self.virtual.stop()
 
 
-def open_backend(config: TestbedConfig, *, plant: str | None = None, faults: Sequence[str] = (),
-                 effects: dict | None = None, realtime: bool = True, plant_in_thread: bool = False,
-                 tracker_noise_mm: float | None = None, tracker_dropout: float | None = None) -> Backend:
+def open_backend(config: TestbedConfig, *, plant: str | None = None, plant_config: Path | None = None,
+                 faults: Sequence[str] = (), effects: dict | None = None, realtime: bool = True,
+                 plant_in_thread: bool = False, tracker_noise_mm: float | None = None,
+                 tracker_dropout: float | None = None) -> Backend:
     """Open the bus and tracker of `config`.
 
-    plant ('package.module:ClassName'), faults ('AXIS:KIND@SECONDS'), effects
-    ({effect id: {param: value}}, added to configs/virtual_plant.toml's) and the tracker's noise
-    and dropout apply to the virtual testbed only. realtime=False leaves time to the caller's
-    `Backend.tick` (tests).
+    plant ('package.module:ClassName'), plant_config (the default plant's description, default
+    configs/virtual_plant.toml), faults ('AXIS:KIND@SECONDS'), effects ({effect id: {param: value}},
+    added to the plant description's) and the tracker's noise and dropout apply to the virtual
+    testbed only. realtime=False leaves time to the caller's `Backend.tick` (tests).
     """
     if config.bus.interface != "virtual":
-        if plant or faults or effects or tracker_noise_mm is not None or tracker_dropout is not None:
-            raise BackendError("--plant, --fault and --effect need the virtual testbed; "
+        if (plant or plant_config or faults or effects or tracker_noise_mm is not None
+                or tracker_dropout is not None):
+            raise BackendError("--plant, --plant-config, --fault and --effect need the virtual testbed; "
                                f"{config.path} selects the real bus '{config.bus.interface}'")
         if config.tracker.port == "sim":
             raise BackendError(f"{config.path}: [tracker].port = 'sim' needs the virtual testbed; "
@@ -75,19 +78,20 @@ def open_backend(config: TestbedConfig, *, plant: str | None = None, faults: Seq
             raise BackendError(f"cannot open CAN interface '{config.bus.interface}' channel "
                                f"'{config.bus.channel}': {exc}. Check the adapter and [bus] in {config.path}") from exc
         return Backend(bus=bus, tracker_port=config.tracker.port)
-    return _open_virtual(config, plant, faults, effects or {}, realtime, plant_in_thread, tracker_noise_mm,
-                         tracker_dropout)
+    return _open_virtual(config, plant, plant_config, faults, effects or {}, realtime, plant_in_thread,
+                         tracker_noise_mm, tracker_dropout)
 
 
-def _open_virtual(config: TestbedConfig, plant_spec: str | None, fault_texts: Sequence[str], effects: dict,
-                  realtime: bool, plant_in_thread: bool, tracker_noise_mm: float | None,
+def _open_virtual(config: TestbedConfig, plant_spec: str | None, plant_toml: Path | None, fault_texts: Sequence[str],
+                  effects: dict, realtime: bool, plant_in_thread: bool, tracker_noise_mm: float | None,
                   tracker_dropout: float | None) -> Backend:
     from sim_backend.faults import parse_fault
     from sim_backend.plant import DahlPlant, PlantConfig, load_plant
+    from sim_backend.plant.dahl_plant import DEFAULT_PLANT_TOML
     from sim_backend.virtual_testbed import TrackerSettings, VirtualTestbed
 
     faults = [parse_fault(text) for text in fault_texts]
-    plant_config = PlantConfig.from_toml().with_effects(effects)
+    plant_config = PlantConfig.from_toml(plant_toml or DEFAULT_PLANT_TOML).with_effects(effects)
     plant = load_plant(plant_spec) if plant_spec else DahlPlant(plant_config)
     specs = [_drive_spec(config, axis) for axis in config.axes]
     # The virtual bus is in-process: a channel of our own per testbed keeps testbeds apart.

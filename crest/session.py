@@ -35,7 +35,7 @@ class Session:
 
 @dataclass(frozen=True)
 class SessionOptions:
-    """What to open. plant/faults/effects apply to the virtual testbed only.
+    """What to open. plant/plant_config/faults/effects/tracker_* apply to the virtual testbed only.
 
     realtime=False runs the virtual testbed in simulated time (deterministic tests).
     """
@@ -43,6 +43,7 @@ class SessionOptions:
     config_path: Path | None = None
     config: TestbedConfig | None = None     # an already loaded configuration (overrides config_path)
     plant: str | None = None
+    plant_config: Path | None = None        # the default plant's description (default configs/virtual_plant.toml)
     faults: Sequence[str] = ()
     effects: dict | None = None
     realtime: bool = True
@@ -56,7 +57,8 @@ class SessionOptions:
 @contextmanager
 def open_session(options: SessionOptions = SessionOptions()) -> Iterator[Session]:
     config = options.config if options.config is not None else load_testbed_config(options.config_path)
-    backend = open_backend(config, plant=options.plant, faults=options.faults, effects=options.effects,
+    backend = open_backend(config, plant=options.plant, plant_config=options.plant_config, faults=options.faults,
+                           effects=options.effects,
                            realtime=options.realtime, tracker_noise_mm=options.tracker_noise_mm,
                            tracker_dropout=options.tracker_dropout)
     with ExitStack() as stack:

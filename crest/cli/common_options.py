@@ -20,6 +20,8 @@ def add_testbed_options(parser: argparse.ArgumentParser) -> None:
                        help="testbed configuration (default configs/testbed.toml: the virtual testbed)")
     group.add_argument("--plant", default=None, metavar="MODULE:CLASS",
                        help="virtual testbed: the plant behind the drives (default: the Dahl catheter)")
+    group.add_argument("--plant-config", type=Path, default=None, metavar="PLANT.toml",
+                       help="virtual testbed: the Dahl catheter's description (default configs/virtual_plant.toml)")
     group.add_argument("--fault", action="append", default=[], metavar="AXIS:KIND@SECONDS",
                        help="virtual testbed: inject a fault, e.g. tendon3:emcy@2.0 or tracker:disconnect@1.5")
     group.add_argument("--effect", action="append", default=[], metavar="ID[:NAME=VALUE,...]",
@@ -58,7 +60,8 @@ def parse_effect(text: str) -> tuple[str, dict]:
 
 def session_options(args: argparse.Namespace, **overrides) -> SessionOptions:
     effects = dict(parse_effect(text) for text in getattr(args, "effect", []))
-    values = dict(config_path=args.config, plant=args.plant, faults=tuple(args.fault), effects=effects,
+    values = dict(config_path=args.config, plant=args.plant, plant_config=args.plant_config,
+                  faults=tuple(args.fault), effects=effects,
                   realtime=not getattr(args, "fast", False))
     values.update(overrides)
     return SessionOptions(**values)

@@ -1,9 +1,13 @@
 """Blind validation of the gap diagnosis on data whose effect is withheld.
 
 Per case: draw an effect (or none, or two) with random parameters, a plant whose base
-parameters and tendon zeros differ from the prior catheter, and random sensor noise; record a
-training and a held-out log of the standard excitation through the log writer; diagnose from
-the two files alone (`diagnose_logs` sees paths, never the draw); score against the draw.
+parameters and tendon zeros differ from the prior catheter, and random tracker noise and
+dropout. The plant is written as a virtual-plant description (`--plant-config`, kept in the
+case's `plant/` folder) and the training and held-out logs are recorded on the virtual testbed
+through `crest excite`'s own path (crest/experiment/excitation_run.py: simulated CiA 402
+drives, the plant behind them, the simulated tracker, the recorder), in simulated time. The
+diagnosis then runs on the two log files alone (`diagnose_logs` sees paths, never the draw),
+and is scored against the draw.
 
 Scores: confusion matrix (true id -> verdict.effect, single and clean cases), top-1 accuracy on
 single effects, `none` accuracy on clean cases, pair accuracy (verdict.effects equals the true
@@ -22,11 +26,13 @@ from pathlib import Path
 
 import numpy as np
 
-from control.excitation import ExcitationGeometry, holdout_trajectory, training_trajectory
+from crest.config import TestbedConfig, load_testbed_config
+from crest.experiment.excitation_run import ExcitationPlan, plan_excitation, record_excitation
 from crest.gap.log_diagnosis import diagnose_logs
 from crest.gap.log_recordings import load_recordings
-from crest.gap.synthetic_logs import Plant, SensorNoise, record_plant_log
-from model import CatheterParams, ModelSolverError
+from crest.gap.synthetic_logs import Plant
+from crest.session import SessionOptions, open_session
+from model import CatheterParams
 from model.effects import EFFECTS, effect
 from model.gap.calibration import ModelFit, rmse_mm, tip_errors
 from model.gap.diagnosis import DiagnosisSettings
@@ -36,16 +42,26 @@ CLEAN_FRACTION = 0.2
 PAIR_FRACTION = 0.15
 MAX_REDRAWS = 5
 TARGETS = {"top1_single": 0.9, "none_clean": 0.8, "shrink_error_pp": 10.0}
+# A plant whose solver fails loses the tracker's tip (the virtual tracker reports the tool missing);
+# one that crawls makes the testbed's cycles slow. Either way the case is redrawn.
+MIN_TIP_FRACTION_BEYOND_DROPOUT = 0.9
+CYCLES_PER_CHECK = 1000
+MAX_CPU_S_PER_CHECK = 30.0     # a normal cycle of the whole virtual testbed costs about 3-4 ms of CPU
+
+
+class PlantFailure(RuntimeError):
+    """The drawn plant's solver failed or crawled on the excitation: no usable log was recorded."""
 
 
 @dataclass(frozen=True)
 class BlindCase:
-    """The hidden truth of one case."""
+    """The hidden truth of one case: the plant behind the drives and the tracker's imperfections."""
 
     index: int
     kind: str                     # "single", "none" or "pair"
     plant: Plant
-    noise: SensorNoise
+    tracker_noise_mm: float       # per axis std
+    tracker_dropout: float        # fraction of tracker frames with the tool missing
     seed: int
     redraws: int = 0
 
@@ -85,7 +101,8 @@ def random_plant(prior: CatheterParams, effect_ids: tuple[str, ...], rng: np.ran
 
 
 def draw_cases(count: int, seed: int, prior: CatheterParams) -> list[BlindCase]:
-    """`count` cases: about 20 % clean, 15 % pairs, the rest single effects cycling through the catalog."""
+    """`count` cases: about 20 % clean, 15 % pairs, the rest single effects cycling through the catalog;
+    tracker noise 0.05-0.2 mm per axis and 0-2 % dropout."""
     rng = np.random.default_rng(seed)
     n_clean = round(CLEAN_FRACTION * count)
     n_pair = round(PAIR_FRACTION * count)
@@ -105,26 +122,65 @@ def draw_cases(count: int, seed: int, prior: CatheterParams) -> list[BlindCase]:
             chosen = ()
         case_seed = int(rng.integers(2 ** 31))
         case_rng = np.random.default_rng(case_seed)
-        noise = SensorNoise(tip_mm=case_rng.uniform(0.05, 0.2), dropout_fraction=case_rng.uniform(0.0, 0.02))
-        cases.append(BlindCase(index, kind, random_plant(prior, chosen, case_rng), noise, case_seed))
+        noise_mm, dropout = case_rng.uniform(0.05, 0.2), case_rng.uniform(0.0, 0.02)
+        cases.append(BlindCase(index, kind, random_plant(prior, chosen, case_rng), noise_mm, dropout, case_seed))
     return cases
 
 
-def record_case(case: BlindCase, folder: Path, prior: CatheterParams, short: bool) -> tuple[BlindCase, Path, Path]:
-    """Training and held-out logs of the case's plant; a plant that diverges is redrawn (same effects)."""
-    geometry = ExcitationGeometry.from_params(prior)
+def write_plant_config(case: BlindCase, folder: Path) -> Path:
+    """The case's plant as a virtual-plant description (configs/virtual_plant.toml's format) and its
+    catheter TOML, in `folder`; returns the description's path."""
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "catheter.toml").write_text(case.plant.params.to_toml())
+    effects = []
+    for effect_id, values in case.plant.effects.items():
+        named = ", ".join(f"{name} = {float(value)!r}" for name, value in zip(effect(effect_id).param_names, values))
+        effects.append(f"{effect_id} = {{ {named} }}")
+    lines = ['catheter = "catheter.toml"', f"n_elements = {case.plant.n_elements}",
+             f"tendon_zero_offsets_mm = [{', '.join(repr(float(v)) for v in case.plant.zero_offsets_mm)}]", "",
+             "[effects]", *effects, "",
+             "[tracker]", f"noise_mm = {case.tracker_noise_mm!r}", f"dropout = {case.tracker_dropout!r}",
+             f"seed = {case.seed}", ""]
+    path = folder / "virtual_plant.toml"
+    path.write_text("\n".join(lines))
+    return path
+
+
+def record_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: ExcitationPlan,
+                prior: CatheterParams) -> tuple[BlindCase, Path, Path]:
+    """Training and held-out logs of the case's plant on the virtual testbed, as `crest excite` records
+    them; a plant whose solver fails or crawls is redrawn (same effects)."""
     for redraw in range(MAX_REDRAWS + 1):
-        rng = np.random.default_rng(case.seed + 7919 * redraw)
-        plant = case.plant if redraw == 0 else random_plant(prior, case.effects, rng)
+        if redraw:
+            rng = np.random.default_rng(case.seed + 7919 * redraw)
+            case = BlindCase(case.index, case.kind, random_plant(prior, case.effects, rng), case.tracker_noise_mm,
+                             case.tracker_dropout, case.seed, redraw)
+        options = SessionOptions(config=config, plant_config=write_plant_config(case, folder / f"plant_{redraw}"),
+                                 realtime=False)
         try:
-            train = record_plant_log(folder / "train.csv", training_trajectory(geometry, short=short), plant,
-                                     case.noise, rng, overwrite=True)
-            holdout = record_plant_log(folder / "holdout.csv", holdout_trajectory(geometry, short=short), plant,
-                                       case.noise, rng, overwrite=True)
-            return BlindCase(case.index, case.kind, plant, case.noise, case.seed, redraw), train, holdout
-        except ModelSolverError:
+            with open_session(options) as session:
+                results = record_excitation(session, plan, folder / f"logs_{redraw}", prior, _crawl_guard())
+        except PlantFailure:
             continue
-    raise ModelSolverError(f"blind case {case.index}: the plant diverged in {MAX_REDRAWS + 1} draws")
+        if all(r.tip_samples >= MIN_TIP_FRACTION_BEYOND_DROPOUT * (1.0 - case.tracker_dropout) * r.cycles
+               for r in results.values()):
+            return case, results["train"].log_path, results["holdout"].log_path
+    raise PlantFailure(f"blind case {case.index}: the plant failed in {MAX_REDRAWS + 1} draws")
+
+
+def _crawl_guard() -> Callable[[str, int, int], None]:
+    """An on_cycle callback that raises PlantFailure when CYCLES_PER_CHECK cycles take over
+    MAX_CPU_S_PER_CHECK of CPU time (a plant solver stuck in step halving)."""
+    clock = [time.process_time()]
+
+    def check(name: str, done: int, total: int) -> None:
+        if done % CYCLES_PER_CHECK == 0:
+            spent = time.process_time() - clock[0]
+            if spent > MAX_CPU_S_PER_CHECK:
+                raise PlantFailure(f"the plant crawls: {spent:.0f} s of CPU for {CYCLES_PER_CHECK} cycles of {name}")
+            clock[0] = time.process_time()
+
+    return check
 
 
 def oracle_shrink(case: BlindCase, holdout: Path, baseline_rmse_mm: float, settings: DiagnosisSettings) -> float:
@@ -134,28 +190,30 @@ def oracle_shrink(case: BlindCase, holdout: Path, baseline_rmse_mm: float, setti
     return 1.0 - rmse_mm(tip_errors(truth, held, settings.resolution)) / baseline_rmse_mm
 
 
-def run_case(case: BlindCase, folder: Path, prior: CatheterParams, settings: DiagnosisSettings,
-             short: bool) -> dict:
-    """Record, diagnose blind, and compare with the truth. A plant that keeps diverging is skipped (reported)."""
-    try:
-        case, train, holdout = record_case(case, folder, prior, short)
-    except ModelSolverError as error:
-        return {"case": case.index, "kind": case.kind, "truth": list(case.effects), "skipped": str(error)}
+def run_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: ExcitationPlan,
+             prior: CatheterParams, settings: DiagnosisSettings) -> dict:
+    """Record, diagnose blind, and compare with the truth. A plant that keeps failing is skipped (reported)."""
     start = time.perf_counter()
+    try:
+        case, train, holdout = record_case(case, folder, config, plan, prior)
+    except PlantFailure as error:
+        return {"case": case.index, "kind": case.kind, "truth": list(case.effects), "skipped": str(error)}
+    recorded = time.perf_counter()
     result = diagnose_logs([train], [holdout], settings=settings)
-    seconds = time.perf_counter() - start
+    seconds = time.perf_counter() - recorded
     verdict = result["verdict"]
     oracle = oracle_shrink(case, holdout, verdict["holdout_rmse_before_mm"], settings)
     return {"case": case.index, "kind": case.kind, "truth": list(case.effects),
             "truth_params": {k: list(v) for k, v in case.plant.effects.items()},
-            "noise_mm": case.noise.tip_mm, "redraws": case.redraws,
+            "noise_mm": case.tracker_noise_mm, "dropout": case.tracker_dropout, "redraws": case.redraws,
             "predicted": verdict["effect"], "predicted_effects": verdict["effects"],
             "holdout_rmse_before_mm": verdict["holdout_rmse_before_mm"],
             "holdout_rmse_after_mm": verdict["holdout_rmse_after_mm"],
+            "noise_floor_mm": result["baseline"]["noise_floor_mm"],
             "predicted_shrink": verdict["shrink"], "oracle_shrink": oracle,
             "shrink_error_pp": 100.0 * abs(verdict["shrink"] - oracle),
-            "top_candidates": [c["effect"] for c in result["candidates"][:3]], "seconds": seconds,
-            "timing_s": result["timing_s"],
+            "top_candidates": [c["effect"] for c in result["candidates"][:3]],
+            "record_seconds": recorded - start, "seconds": seconds, "timing_s": result["timing_s"],
             "slowest_candidate": max(result["candidates"], key=lambda c: c["seconds"])["effect"]}
 
 
@@ -195,22 +253,33 @@ def score(all_rows: list[dict]) -> dict:
 def run_blind_benchmark(cases: int = 40, seed: int = 0, *, short: bool = False,
                         settings: DiagnosisSettings = DiagnosisSettings(), work_dir: Path | str | None = None,
                         progress: Callable[[str], None] | None = None) -> dict:
-    """Draw, record, diagnose and score `cases` blind cases; returns {"score", "cases", "settings"}."""
+    """Draw, record, diagnose and score `cases` blind cases; returns {"score", "cases", "settings"}.
+
+    work_dir keeps each case's plant description and logs (default: a temporary folder).
+    """
     say = progress or (lambda message: None)
     prior = CatheterParams.from_toml()
+    config = load_testbed_config()
+    plan = plan_excitation(config, prior, short=short)
     rows = []
+    clock = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="crest-blind-") as scratch:
         root = Path(work_dir) if work_dir else Path(scratch)
         for case in draw_cases(cases, seed, prior):
-            folder = root / f"case_{case.index:03d}"
-            folder.mkdir(parents=True, exist_ok=True)
-            rows.append(run_case(case, folder, prior, settings, short))
+            rows.append(run_case(case, root / f"case_{case.index:03d}", config, plan, prior, settings))
             row = rows[-1]
+            elapsed = time.perf_counter() - clock
+            eta = elapsed / len(rows) * (cases - len(rows))
+            head = f"blind case {case.index + 1}/{cases} ({elapsed / 60:.0f} min, about {eta / 60:.0f} min left)"
             if "skipped" in row:
-                say(f"blind case {case.index + 1}/{cases}: skipped, {row['skipped']}")
+                say(f"{head}: skipped, {row['skipped']}")
                 continue
-            say(f"blind case {case.index + 1}/{cases}: truth {'+'.join(row['truth']) or 'none'}, "
-                f"verdict {'+'.join(row['predicted_effects']) or 'none'}, shrink {row['predicted_shrink']:.2f} "
-                f"(oracle {row['oracle_shrink']:.2f}), {row['seconds']:.0f} s")
+            say(f"{head}: truth {'+'.join(row['truth']) or 'none'}, verdict "
+                f"{'+'.join(row['predicted_effects']) or 'none'}, shrink {row['predicted_shrink']:.2f} "
+                f"(oracle {row['oracle_shrink']:.2f}), recorded in {row['record_seconds']:.0f} s, "
+                f"diagnosed in {row['seconds']:.0f} s")
+    total = time.perf_counter() - clock
     return {"score": score(rows), "cases": rows,
-            "settings": {"cases": cases, "seed": seed, "excitation": "short" if short else "standard"}}
+            "settings": {"cases": cases, "seed": seed, "excitation": "short" if short else "standard",
+                         "path": "virtual testbed, crest excite", "seconds": total,
+                         "seconds_per_case": total / max(1, cases)}}

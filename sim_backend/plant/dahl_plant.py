@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -19,7 +19,12 @@ class PlantConfigError(ValueError):
 
 @dataclass(frozen=True)
 class PlantConfig:
-    """What the virtual testbed's catheter is: parameters, mismatch, effects, tracker noise."""
+    """What the virtual testbed's catheter is: parameters, mismatch, effects, tracker noise.
+
+    tendon_zero_offsets_mm: where each tendon's just-taut position lies from its drive's zero;
+    the catheter sees u_k - zero_k (a real testbed's homing leaves such offsets of micrometres,
+    a newton of pretension each on stiff tendons).
+    """
 
     params: CatheterParams = field(default_factory=CatheterParams)
     n_elements: int = 20
@@ -27,6 +32,7 @@ class PlantConfig:
     tracker_noise_mm: float = 0.05
     tracker_dropout: float = 0.0
     tracker_seed: int = 1
+    tendon_zero_offsets_mm: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
 
     @property
     def effect_terms(self) -> EffectTerms:
@@ -41,11 +47,14 @@ class PlantConfig:
             params = params.replace(**{name: getattr(params, name) * _factor(name, factor)
                                        for name, factor in raw.get("mismatch", {}).items()})
             tracker = raw.get("tracker", {})
+            zeros = tuple(float(v) for v in raw.get("tendon_zero_offsets_mm", (0.0, 0.0, 0.0, 0.0)))
+            if len(zeros) != 4:
+                raise ValueError(f"tendon_zero_offsets_mm needs 4 values (mm), got {len(zeros)}")
             config = cls(params=params, n_elements=int(raw.get("n_elements", 20)),
                          effects={k: dict(v) for k, v in raw.get("effects", {}).items()},
                          tracker_noise_mm=float(tracker.get("noise_mm", 0.05)),
                          tracker_dropout=float(tracker.get("dropout", 0.0)),
-                         tracker_seed=int(tracker.get("seed", 1)))
+                         tracker_seed=int(tracker.get("seed", 1)), tendon_zero_offsets_mm=zeros)
             config.effect_terms  # validates effect ids, names and ranges
         except (OSError, tomllib.TOMLDecodeError, ValueError, TypeError, AttributeError) as exc:
             raise PlantConfigError(f"{path}: {exc}") from exc
@@ -58,8 +67,7 @@ class PlantConfig:
         merged = dict(self.effects)
         merged.update(effects)
         combined_terms(merged)
-        return PlantConfig(self.params, self.n_elements, merged, self.tracker_noise_mm,
-                           self.tracker_dropout, self.tracker_seed)
+        return replace(self, effects=merged)
 
 
 def _factor(name: str, value) -> float:
@@ -80,6 +88,6 @@ class DahlPlant:
 
     def step(self, dt_s: float, tendon_mm, insertion_mm: float) -> tuple[np.ndarray, np.ndarray]:
         """Advance to the drives' positions; returns (tip_mm (3,), tendon tension at the drives (4,))."""
-        tendons = np.asarray(tendon_mm, dtype=float).reshape(1, 4)
+        tendons = np.asarray(tendon_mm, dtype=float).reshape(1, 4) - np.asarray(self.config.tendon_zero_offsets_mm)
         tip = self.model.run(tendons, np.array([float(insertion_mm)]), dt_s=max(float(dt_s), 1e-6))[0]
         return tip, np.maximum(self.model.drive_tension_n, 0.0)
