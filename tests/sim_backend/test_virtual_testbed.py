@@ -10,7 +10,7 @@ import canopen
 import numpy as np
 import pytest
 
-from drive_bench import EDS_PATH, MASTER_NODE_ID, insertion_spec, tendon_spec
+from drive_bench import EDS_PATH, insertion_spec, tendon_spec
 from sim_backend.plant import DahlPlant, PlantConfig
 from sim_backend.virtual_testbed import TrackerSettings, VirtualTestbed
 
