@@ -85,7 +85,7 @@ class CandidateResult:
                 "model_runs": self.fit.model_runs, "seconds": self.seconds}
 
 
-EXPLORE = "explore"     # single candidates and the plain refit: three starts, explored
+EXPLORE = "explore"     # single candidates and the plain refit: four starts, explored
 PROBE = "probe"         # a second effect: probed from the start's base parameters
 CONTINUE = "continue"   # a control: the start as given
 
@@ -114,13 +114,14 @@ def run_task(task: FitTask) -> CandidateResult:
     """Fit the task's effects with the base parameters, evaluate on held-out data, ablate.
 
     The last effect of the task is the one being added. Where its fit starts depends on the mode:
-    - EXPLORE: three starts, each explored by a short fit, the best one then fitted to the end:
-      the continuation (the start fit, e.g. the baseline, with the effect off) and two fresh
-      starts, zero tendon zeros with the start's or the prior's other parameters, each with the
-      effect at the probe value that fits the training data best (one model run each). A
-      baseline that lacks an effect has bent its parameters (its tendon zeros bend the catheter
-      at rest in place of gravity or precurvature, its friction imitates backlash, slack tendons
-      and a stiff shaft imitate tendon elasticity), and the continuation can stall there.
+    - EXPLORE: four starts, each explored by a short fit, the best one then fitted to the end:
+      the continuation (the start fit, e.g. the baseline, with the effect off), the same with the
+      effect at the probe value that fits the training data best (one model run each), and two
+      fresh starts, zero tendon zeros with the start's or the prior's other parameters, each
+      with its best probe value. A baseline that lacks an effect has bent its parameters (its
+      tendon zeros bend the catheter at rest in place of gravity or precurvature, its friction
+      imitates backlash, slack tendons and a stiff shaft imitate tendon elasticity), and the
+      continuation can stall there.
     - PROBE: the start fit with the effect at its best probe value.
     - CONTINUE: the start fit and effect values as given.
     """
@@ -136,9 +137,10 @@ def run_task(task: FitTask) -> CandidateResult:
     start = task.start
     if task.mode == EXPLORE:
         candidates = [with_last(start.params, start.zero_offsets_mm, start_values(last) if last else ())]
-        for base in (start.params, catheter_for(task.prior, train)):
-            fresh = [with_last(base, (0.0, 0.0, 0.0, 0.0), probe) for probe in probes]
-            candidates.append(fresh[int(np.argmin(_probe_costs(fresh, train, task.resolution)))])
+        for base, zeros in ((start.params, start.zero_offsets_mm), (start.params, (0.0, 0.0, 0.0, 0.0)),
+                            (catheter_for(task.prior, train), (0.0, 0.0, 0.0, 0.0))):
+            probed = [with_last(base, zeros, probe) for probe in probes]
+            candidates.append(probed[int(np.argmin(_probe_costs(probed, train, task.resolution)))])
         start = best_start(task.train, candidates, task.prior, task.resolution)
     elif task.mode == PROBE:
         probed = [with_last(start.params, start.zero_offsets_mm, probe) for probe in probes]
