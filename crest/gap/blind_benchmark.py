@@ -18,6 +18,7 @@ added to the model and calibrated with it on the training log, starting from the
 """
 from __future__ import annotations
 
+import json
 import math
 import tempfile
 import time
@@ -30,6 +31,7 @@ import numpy as np
 from crest.config import TestbedConfig, load_testbed_config
 from crest.driver import SafetyStop
 from crest.experiment.excitation_run import ExcitationPlan, plan_excitation, record_excitation
+from crest.gap.isolated_call import CallTimedOut, call_isolated
 from crest.gap.log_diagnosis import diagnose_logs
 from crest.gap.log_recordings import load_recordings
 from crest.gap.synthetic_logs import Plant
@@ -44,11 +46,13 @@ CLEAN_FRACTION = 0.2
 PAIR_FRACTION = 0.15
 MAX_REDRAWS = 5
 TARGETS = {"top1_single": 0.9, "none_clean": 0.8, "shrink_error_pp": 10.0}
-# A plant whose solver fails loses the tracker's tip (the virtual tracker reports the tool missing);
-# one that crawls makes the testbed's cycles slow. Either way the case is redrawn.
+NO_RESULT = "no result"
+# A plant whose solver fails loses the tracker's tip (the virtual tracker reports the tool missing),
+# reports absurd tensions (the testbed's safety stop ends the run) or never returns (the recording
+# exceeds its time limit). Each way the case is redrawn.
 MIN_TIP_FRACTION_BEYOND_DROPOUT = 0.9
-CYCLES_PER_CHECK = 1000
-MAX_CPU_S_PER_CHECK = 30.0     # a normal cycle of the whole virtual testbed costs about 3-4 ms of CPU
+RECORD_TIMEOUT_S = 900.0      # recording both logs normally takes 1-2 min
+DIAGNOSIS_TIMEOUT_S = 900.0   # a diagnosis normally takes 15-40 s
 
 
 class PlantFailure(RuntimeError):
@@ -151,8 +155,8 @@ def write_plant_config(case: BlindCase, folder: Path) -> Path:
 def record_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: ExcitationPlan,
                 prior: CatheterParams) -> tuple[BlindCase, Path, Path]:
     """Training and held-out logs of the case's plant on the virtual testbed, as `crest excite` records
-    them; a plant whose solver fails (the tip is lost, or absurd tensions make the testbed stop) or
-    crawls is redrawn (same effects)."""
+    them (in a process of its own, see `call_isolated`); a plant whose solver fails is redrawn (same
+    effects)."""
     for redraw in range(MAX_REDRAWS + 1):
         if redraw:
             rng = np.random.default_rng(case.seed + 7919 * redraw)
@@ -161,9 +165,9 @@ def record_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Exci
         options = SessionOptions(config=config, plant_config=write_plant_config(case, folder / f"plant_{redraw}"),
                                  realtime=False)
         try:
-            with open_session(options) as session:
-                results = record_excitation(session, plan, folder / f"logs_{redraw}", prior, _crawl_guard())
-        except (PlantFailure, SafetyStop):   # a diverged plant can report absurd tensions: the testbed stops
+            results = call_isolated(_record, options, plan, folder / f"logs_{redraw}", prior,
+                                    timeout_s=RECORD_TIMEOUT_S)
+        except (PlantFailure, CallTimedOut):
             continue
         if all(r.tip_samples >= MIN_TIP_FRACTION_BEYOND_DROPOUT * (1.0 - case.tracker_dropout) * r.cycles
                for r in results.values()):
@@ -171,19 +175,12 @@ def record_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Exci
     raise PlantFailure(f"blind case {case.index}: the plant failed in {MAX_REDRAWS + 1} draws")
 
 
-def _crawl_guard() -> Callable[[str, int, int], None]:
-    """An on_cycle callback that raises PlantFailure when CYCLES_PER_CHECK cycles take over
-    MAX_CPU_S_PER_CHECK of CPU time (a plant solver stuck in step halving)."""
-    clock = [time.process_time()]
-
-    def check(name: str, done: int, total: int) -> None:
-        if done % CYCLES_PER_CHECK == 0:
-            spent = time.process_time() - clock[0]
-            if spent > MAX_CPU_S_PER_CHECK:
-                raise PlantFailure(f"the plant crawls: {spent:.0f} s of CPU for {CYCLES_PER_CHECK} cycles of {name}")
-            clock[0] = time.process_time()
-
-    return check
+def _record(options: SessionOptions, plan: ExcitationPlan, folder: Path, prior: CatheterParams) -> dict:
+    try:
+        with open_session(options) as session:
+            return record_excitation(session, plan, folder, prior)
+    except SafetyStop as stop:      # a diverged plant reported absurd tensions
+        raise PlantFailure(str(stop)) from None
 
 
 def oracle_shrinks(case: BlindCase, train: Path, holdout: Path, prior: CatheterParams, baseline_rmse_mm: float,
@@ -213,7 +210,11 @@ def run_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Excitat
     except PlantFailure as error:
         return {"case": case.index, "kind": case.kind, "truth": list(case.effects), "skipped": str(error)}
     recorded = time.perf_counter()
-    result = diagnose_logs([train], [holdout], settings=settings)
+    try:
+        result = call_isolated(diagnose_logs, [train], [holdout], settings=settings, timeout_s=DIAGNOSIS_TIMEOUT_S)
+    except CallTimedOut as error:
+        return {"case": case.index, "kind": case.kind, "truth": list(case.effects), "redraws": case.redraws,
+                "record_seconds": recorded - start, "no_result": str(error)}
     seconds = time.perf_counter() - recorded
     verdict = result["verdict"]
     oracle, exact = oracle_shrinks(case, train, holdout, prior, verdict["holdout_rmse_before_mm"], settings)
@@ -232,10 +233,13 @@ def run_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Excitat
 
 
 def score(all_rows: list[dict]) -> dict:
-    """Confusion matrix and accuracies (see module doc); skipped cases are counted, not scored."""
-    rows = [r for r in all_rows if "skipped" not in r]
-    labels = list(EFFECTS) + ["none"]
-    confusion = {t: {p: 0 for p in labels} for t in labels}
+    """Confusion matrix and accuracies (see module doc). Skipped cases (no plant could be recorded) are
+    counted, not scored; a case whose diagnosis gave no result counts as wrong (verdict NO_RESULT)
+    and has no shrink error."""
+    rows = [r if "no_result" not in r else {**r, "predicted": NO_RESULT, "predicted_effects": []}
+            for r in all_rows if "skipped" not in r]
+    labels = list(EFFECTS) + ["none", NO_RESULT]
+    confusion = {t: {p: 0 for p in labels} for t in labels[:-1]}
     for row in rows:
         if row["kind"] in ("single", "none"):
             truth = row["truth"][0] if row["truth"] else "none"
@@ -243,7 +247,7 @@ def score(all_rows: list[dict]) -> dict:
     singles = [r for r in rows if r["kind"] == "single"]
     clean = [r for r in rows if r["kind"] == "none"]
     pairs = [r for r in rows if r["kind"] == "pair"]
-    errors = [r["shrink_error_pp"] for r in rows]
+    errors = [r["shrink_error_pp"] for r in rows if "shrink_error_pp" in r]
 
     def fraction(hits: list[bool]) -> float | None:
         return float(np.mean(hits)) if hits else None
@@ -259,7 +263,7 @@ def score(all_rows: list[dict]) -> dict:
                             "within_10pp": float(np.mean([e <= 10.0 for e in errors]))} if errors else None,
         "confusion": confusion,
         "counts": {"single": len(singles), "none": len(clean), "pair": len(pairs),
-                   "skipped": len(all_rows) - len(rows)},
+                   "skipped": len(all_rows) - len(rows), "no_result": sum("no_result" in r for r in rows)},
         "targets": TARGETS,
     }
 
@@ -285,8 +289,9 @@ def run_blind_benchmark(cases: int = 40, seed: int = 0, *, short: bool = False,
             elapsed = time.perf_counter() - clock
             eta = elapsed / len(rows) * (cases - len(rows))
             head = f"blind case {case.index + 1}/{cases} ({elapsed / 60:.0f} min, about {eta / 60:.0f} min left)"
-            if "skipped" in row:
-                say(f"{head}: skipped, {row['skipped']}")
+            (root / "cases.json").write_text(json.dumps(rows, indent=1))    # kept should the run be cut short
+            if "skipped" in row or "no_result" in row:
+                say(f"{head}: truth {'+'.join(row['truth']) or 'none'}, {row.get('skipped') or row['no_result']}")
                 continue
             say(f"{head}: truth {'+'.join(row['truth']) or 'none'}, verdict "
                 f"{'+'.join(row['predicted_effects']) or 'none'}, shrink {row['predicted_shrink']:.2f} "
