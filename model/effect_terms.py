@@ -42,7 +42,8 @@ class EffectTerms:
         play of this width at each reversal of insertion.
     gravity_m_s2: acceleration of gravity in the base frame (sag under own weight).
     twist_rad: torsion: the lumens turn by this angle from base to tip, coupling the planes.
-    rate_friction_s_per_mm: velocity-strengthening friction, Fs*(1 + c*|v|), v in mm/s.
+    rate_friction_s_per_mm: velocity-strengthening friction, Fs*(1 + c*|v|), v the tendon's pull
+        speed in mm/s.
     precurvature_per_mm: residual rest curvature (kx, ky) of the unactuated catheter.
     tracker_offset_mm: rigid registration error of the tip sensor (added to the tip).
     """

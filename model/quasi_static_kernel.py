@@ -322,15 +322,14 @@ def _tip_tensions(u, compliance, dist_force, dist_short, slack, revived, tip_ten
 
 
 @kernel
-def _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_per_step, friction, increment, tension,
+def _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_scale, friction, increment, tension,
                        slack, f0, kx, gt, gth, bend_dir):
     """Exact Dahl forces of element i after the sliding `increment`, and their derivatives.
 
-    Slack tendons get zeros. Fs = s*(Fsc + gain(theta)*T) with gain = 2 tanh(mu theta/2)
-    (capstan_gain) and the rate-friction scale s = 1 + c_rate*|v|, v = increment/dt
-    (rate_per_step = c_rate/dt). Returns, per tendon, F0 = dahl_update(...), dF/dx,
-    gt = dF/dFs * s*gain (own tension), gth = dF/dFs * s*T*dgain/dtheta with
-    dgain/dtheta = mu*(1 - tanh^2(mu theta/2)).
+    Slack tendons get zeros. Fs = s_k*(Fsc + gain(theta)*T) with gain = 2 tanh(mu theta/2)
+    (capstan_gain) and the rate-friction scale s_k of tendon k (fixed within the step, see
+    run_path). Returns, per tendon, F0 = dahl_update(...), dF/dx, gt = dF/dFs * s*gain (own
+    tension), gth = dF/dFs * s*T*dgain/dtheta with dgain/dtheta = mu*(1 - tanh^2(mu theta/2)).
     """
     theta = math.sqrt(bx * bx + by * by)
     gain = capstan_gain(mu, theta)
@@ -348,14 +347,12 @@ def _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_per_step, friction
             gt[k, i] = 0.0
             gth[k, i] = 0.0
             continue
-        s = 1.0 + rate_per_step * abs(increment[k, i])
+        s = rate_scale[k]
         t = max(tension[k, i], 0.0)
         fs = s * (fsc + gain * t)
         force, d_dx, d_fs = dahl_update_with_slopes(friction[k, i], increment[k, i], fs, sigma, alpha)
         f0[k, i] = force
-        # dF/dx also moves Fs through the rate scale: ds/dx = c_rate/dt * sgn(dx)
-        rate_slope = rate_per_step * (fsc + gain * t) * (1.0 if increment[k, i] >= 0.0 else -1.0)
-        kx[k, i] = d_dx + d_fs * rate_slope
+        kx[k, i] = d_dx
         gt[k, i] = d_fs * s * gain if tension[k, i] > 0.0 else 0.0
         gth[k, i] = d_fs * s * t * dgain
 
@@ -377,13 +374,13 @@ def make_workspace(n):
 
 
 @kernel
-def quasi_static_step(u, length, dt_s, params, effects, point_loads, friction, sliding, last_step, tension,
+def quasi_static_step(u, length, rate_scale, params, effects, point_loads, friction, sliding, last_step, tension,
                       bend, compression, tip_tension, drive_tension, slack, points, frames, scalars, work,
                       commit_unconverged):
     """Advance the catheter state to equilibrium at tendon input u [mm] and free length [mm].
 
-    `dt_s` is the time the step takes (inf for a purely quasi-static move); it only enters
-    the rate-dependent friction term. `work` is scratch space from make_workspace. Returns
+    `rate_scale[k]` multiplies tendon k's friction strength (rate friction, 1 without it).
+    `work` is scratch space from make_workspace. Returns
     True when Newton converged; the state arrays are then updated in place. An unconverged
     step leaves the state untouched (the caller retries with a smaller step) unless
     `commit_unconverged`.
@@ -396,7 +393,6 @@ def quasi_static_step(u, length, dt_s, params, effects, point_loads, friction, s
     mu = params[P_MU]
     alpha = params[P_ALPHA]
     compliance = effects[E_TENDON_COMPLIANCE]
-    rate_per_step = effects[E_RATE] / dt_s if (dt_s > 0.0 and math.isfinite(dt_s)) else 0.0
 
     (arm, angle, rest_bend, ext_bend, cos_phi, sin_phi, f0, kx, gt, gth, bend_dir, xref, tref, lin_force,
      distal_force, distal_short, dist_force, dist_short, new_force, new_sliding, new_tension,
@@ -415,7 +411,7 @@ def quasi_static_step(u, length, dt_s, params, effects, point_loads, friction, s
     # exact Dahl integration at each iterate.
     tref[:, :] = tension
     for i in range(n):
-        _linearise_element(i, bend[i, 0], bend[i, 1], mu, fsc, sigma, alpha, rate_per_step, friction,
+        _linearise_element(i, bend[i, 0], bend[i, 1], mu, fsc, sigma, alpha, rate_scale, friction,
                            last_step, tension, slack, f0, kx, gt, gth, bend_dir)
         for k in range(4):
             xref[k, i] = sliding[k, i] + last_step[k, i]
@@ -483,7 +479,7 @@ def quasi_static_step(u, length, dt_s, params, effects, point_loads, friction, s
                 increment[k, i] = new_sliding[k, i] - sliding[k, i]
             for k in range(4):
                 previous_increment[k] = xref[k, i] - sliding[k, i]
-            _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_per_step, friction, increment,
+            _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_scale, friction, increment,
                                new_tension, slack, f0, kx, gt, gth, bend_dir)
             for k in range(4):
                 # Dahl has a kink at zero sliding (one-sided slopes differ up to 2 sigma). Where the
@@ -598,10 +594,18 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
     point_loads (K, 4): external point forces (fx, fy, fz [N], distance from the tip [mm]).
     Each sample is split into sub-steps of at most max_tendon_step_mm / max_insertion_step_mm
     so that the friction state follows the path (history) and not just its end point.
+
+    Rate friction scales tendon k's friction strength by s_k = 1 + c_rate*|v_k| over the
+    sample, v_k = (u_k(t) - u_k(t-1)) / dt_s its pull speed past the drive-train play (0 for
+    dt_s = inf, a purely quasi-static move). The scale is known before the solve, so it adds
+    no discontinuity to Newton's system (a scale on each element's own sliding increment did,
+    at every reversal).
     """
     n_samples = tendon_mm.shape[0]
     target = np.empty(4)
     u = np.empty(4)
+    rate_scale = np.ones(4)
+    rate_per_mm = effects[E_RATE] / dt_s if (dt_s > 0.0 and math.isfinite(dt_s)) else 0.0
     work = make_workspace(bend.shape[0])
     for t in range(n_samples):
         for k in range(4):
@@ -610,6 +614,7 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
         span = 0.0
         for k in range(4):
             span = max(span, abs(target[k] - applied_tendon_mm[k]))
+            rate_scale[k] = 1.0 + rate_per_mm * abs(target[k] - applied_tendon_mm[k])
         n_sub = max(1, int(math.ceil(span / max_tendon_step_mm)),
                     int(math.ceil(abs(length_target - applied_insertion_mm[0]) / max_insertion_step_mm)))
         start_length = applied_insertion_mm[0]
@@ -628,7 +633,7 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
             previous_length = length
             length = start_length + w * (length_target - start_length)
             remap_to_length(previous_length, length, friction, sliding, last_step, tension)
-            if quasi_static_step(u, length, dt_s * fraction, params, effects, point_loads, friction, sliding,
+            if quasi_static_step(u, length, rate_scale, params, effects, point_loads, friction, sliding,
                                  last_step, tension, bend, compression, tip_tension, drive_tension, slack, points,
                                  frames, scalars, work, fraction <= smallest):
                 done = w

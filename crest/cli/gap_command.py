@@ -86,7 +86,9 @@ def format_score(score: dict) -> str:
     shrink = score["shrink_error_pp"] or {}
     return "\n".join([
         f"blind benchmark, {score['cases']} cases ({score['counts']})",
-        f"top-1 on single effects: {pct(score['top1_single'])} (target >= 90 %)",
+        f"top-1 on single effects: {pct(score['top1_single'])} (target >= 90 %); on the "
+        f"{score['counts']['single'] - score['counts']['single_below_noise']} whose effect moves the tip by more "
+        f"than the tracker noise: {pct(score['top1_single_above_noise'])}",
         f"'none' on clean cases: {pct(score['none_clean'])} (target >= 80 %)",
         f"pairs: exact {pct(score['pair_exact'])}, at least one found {pct(score['pair_any_found'])}",
         f"shrink error vs oracle: mean {shrink.get('mean', float('nan')):.1f} pp (target <= 10 pp), median "

@@ -10,8 +10,9 @@ diagnosis then runs on the two log files alone (`diagnose_logs` sees paths, neve
 and is scored against the draw.
 
 Scores: confusion matrix (true id -> verdict.effect, single and clean cases), top-1 accuracy on
-single effects, `none` accuracy on clean cases, pair accuracy (verdict.effects equals the true
-pair; and at least one found), and the error of the predicted shrink against the oracle shrink
+single effects (all of them, and those whose effect moves the held-out tip by at least the
+tracker noise, 3-D RMS: below it no method can be expected to see it), `none` accuracy on clean
+cases, pair accuracy (verdict.effects equals the true pair; and at least one found), and the error of the predicted shrink against the oracle shrink
 1 - RMSE(true effects added) / RMSE(baseline) on the held-out log, where the true effects are
 added to the model and calibrated with it on the training log, starting from the drawn values
 (`oracle_shrinks`; the shrink of the exact drawn plant is reported beside it).
@@ -84,7 +85,7 @@ def random_effect_values(effect_id: str, rng: np.random.Generator) -> tuple[floa
         return (scale * typical[0], rng.uniform(10.0, 40.0))
     if effect_id == "gravity":
         angle = rng.uniform(0, 2 * math.pi)
-        g = 9.81 * rng.uniform(0.8, 1.6)
+        g = 9.81 * rng.uniform(1.0, 2.0)     # 1 g sags the prior catheter 0.3 mm at 80 mm, 2 g 1 mm
         return (g * math.cos(angle), g * math.sin(angle), 9.81 * rng.uniform(-0.3, 0.3))
     if effect_id in ("tracker_offset", "precurvature"):
         direction = rng.normal(size=len(typical))
@@ -184,13 +185,16 @@ def _record(options: SessionOptions, plan: ExcitationPlan, folder: Path, prior: 
 
 
 def oracle_shrinks(case: BlindCase, train: Path, holdout: Path, prior: CatheterParams, baseline_rmse_mm: float,
-                   settings: DiagnosisSettings) -> tuple[float, float]:
-    """The held-out shrink 1 - RMSE / baseline RMSE when the true effects are added, two ways:
+                   settings: DiagnosisSettings) -> tuple[float, float, float]:
+    """The held-out shrink 1 - RMSE / baseline RMSE when the true effects are added, two ways, and
+    the size of the effects:
 
     fitted (the oracle the prediction is scored against): the true effects added to the model and
     calibrated with the base parameters on the training log, from the true plant's values, as the
-    diagnosis fits a candidate; exact: the true plant simulated at the diagnosis' resolution (it
-    also carries the difference between that resolution and the plant's).
+    diagnosis fits a candidate (where that fit ends worse on the training log than the true plant
+    itself, a local minimum, the true plant is the oracle); exact: the true plant simulated at the diagnosis' resolution (it
+    also carries the difference between that resolution and the plant's); effect size: the RMS
+    distance on the held-out log between the true plant's tip with and without its effects.
     """
     res = settings.resolution
     held = res.prepare(load_recordings([holdout]))
@@ -198,7 +202,16 @@ def oracle_shrinks(case: BlindCase, train: Path, holdout: Path, prior: CatheterP
     fitted = calibrate(load_recordings([train]), case.plant.params, prior=prior,
                        zero_offsets_mm=case.plant.zero_offsets_mm, effects=dict(case.plant.effects), resolution=res,
                        max_iterations=settings.candidate_iterations)
-    return tuple(1.0 - rmse_mm(tip_errors(fit, held, res)) / baseline_rmse_mm for fit in (fitted, truth))
+    train_truth = ModelFit(catheter_for(case.plant.params, load_recordings([train])), case.plant.zero_offsets_mm,
+                           dict(case.plant.effects))
+    if rmse_mm(tip_errors(train_truth, res.prepare_training(load_recordings([train])), res)) < fitted.train_rmse_mm:
+        fitted = truth
+    truth_errors = tip_errors(truth, held, res)
+    without = tip_errors(ModelFit(truth.params, truth.zero_offsets_mm, {}), held, res)
+    effect_rms_mm = rmse_mm([a - b for a, b in zip(truth_errors, without)])
+    fitted_shrink, exact_shrink = (1.0 - rmse_mm(errors) / baseline_rmse_mm
+                                   for errors in (tip_errors(fitted, held, res), truth_errors))
+    return fitted_shrink, exact_shrink, effect_rms_mm
 
 
 def run_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: ExcitationPlan,
@@ -217,7 +230,8 @@ def run_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Excitat
                 "record_seconds": recorded - start, "no_result": str(error)}
     seconds = time.perf_counter() - recorded
     verdict = result["verdict"]
-    oracle, exact = oracle_shrinks(case, train, holdout, prior, verdict["holdout_rmse_before_mm"], settings)
+    oracle, exact, effect_rms_mm = oracle_shrinks(case, train, holdout, prior, verdict["holdout_rmse_before_mm"],
+                                                  settings)
     return {"case": case.index, "kind": case.kind, "truth": list(case.effects),
             "truth_params": {k: list(v) for k, v in case.plant.effects.items()},
             "noise_mm": case.tracker_noise_mm, "dropout": case.tracker_dropout, "redraws": case.redraws,
@@ -226,6 +240,7 @@ def run_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Excitat
             "holdout_rmse_after_mm": verdict["holdout_rmse_after_mm"],
             "noise_floor_mm": result["baseline"]["noise_floor_mm"],
             "predicted_shrink": verdict["shrink"], "oracle_shrink": oracle, "exact_truth_shrink": exact,
+            "effect_rms_mm": effect_rms_mm, "above_noise": effect_rms_mm >= math.sqrt(3.0) * case.tracker_noise_mm,
             "shrink_error_pp": 100.0 * abs(verdict["shrink"] - oracle),
             "top_candidates": [c["effect"] for c in result["candidates"][:3]],
             "record_seconds": recorded - start, "seconds": seconds, "timing_s": result["timing_s"],
@@ -245,6 +260,7 @@ def score(all_rows: list[dict]) -> dict:
             truth = row["truth"][0] if row["truth"] else "none"
             confusion[truth][row["predicted"]] += 1
     singles = [r for r in rows if r["kind"] == "single"]
+    audible = [r for r in singles if r.get("above_noise", True)]     # a case without a result counts
     clean = [r for r in rows if r["kind"] == "none"]
     pairs = [r for r in rows if r["kind"] == "pair"]
     errors = [r["shrink_error_pp"] for r in rows if "shrink_error_pp" in r]
@@ -255,6 +271,7 @@ def score(all_rows: list[dict]) -> dict:
     return {
         "cases": len(all_rows),
         "top1_single": fraction([r["predicted"] == r["truth"][0] for r in singles]),
+        "top1_single_above_noise": fraction([r["predicted"] == r["truth"][0] for r in audible]),
         "none_clean": fraction([r["predicted"] == "none" for r in clean]),
         "pair_exact": fraction([sorted(r["predicted_effects"]) == sorted(r["truth"]) for r in pairs]),
         "pair_any_found": fraction([bool(set(r["predicted_effects"]) & set(r["truth"])) for r in pairs]),
@@ -262,7 +279,8 @@ def score(all_rows: list[dict]) -> dict:
                             "max": float(np.max(errors)),
                             "within_10pp": float(np.mean([e <= 10.0 for e in errors]))} if errors else None,
         "confusion": confusion,
-        "counts": {"single": len(singles), "none": len(clean), "pair": len(pairs),
+        "counts": {"single": len(singles), "single_below_noise": len(singles) - len(audible),
+                   "none": len(clean), "pair": len(pairs),
                    "skipped": len(all_rows) - len(rows), "no_result": sum("no_result" in r for r in rows)},
         "targets": TARGETS,
     }

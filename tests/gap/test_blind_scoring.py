@@ -35,3 +35,11 @@ def test_scores_count_hits_misses_and_shrink_errors():
     assert result["confusion"]["gravity"]["tracker_offset"] == 1 and result["confusion"]["none"]["torsion"] == 1
     assert result["shrink_error_pp"]["max"] == pytest.approx(20.0)
     assert result["shrink_error_pp"]["within_10pp"] == pytest.approx(5 / 6)
+
+
+def test_effects_below_the_tracker_noise_are_scored_apart_but_still_counted():
+    rows = [{**row("single", ["backlash"], "backlash"), "above_noise": True},
+            {**row("single", ["gravity"], "none"), "above_noise": False}]
+    result = score(rows)
+    assert result["top1_single"] == 0.5 and result["top1_single_above_noise"] == 1.0
+    assert result["counts"]["single_below_noise"] == 1
