@@ -1,7 +1,7 @@
 """`crest gap`: diagnose the sim-to-real gap of logs, or validate the diagnosis blind.
 
     crest gap TRAIN.csv [...] --holdout TEST.csv [...] --json OUT.json --report DIR
-    crest gap --blind-benchmark --cases 40 --seed S --json OUT.json
+    crest gap --blind-benchmark --cases 40 --seed S --json OUT.json --report DIR
 """
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ from pathlib import Path
 from crest.gap.blind_benchmark import run_blind_benchmark
 from crest.gap.log_diagnosis import diagnose_logs
 from crest.gap.log_recordings import load_recordings
+from crest.reports.blind_report import write_blind_report
 from crest.reports.gap_report import write_gap_report
 from model.gap.diagnosis import DiagnosisSettings
 
@@ -22,7 +23,7 @@ def add_parser(sub) -> None:
     parser.add_argument("train", nargs="*", type=Path, help="training logs (crest-log/1)")
     parser.add_argument("--holdout", nargs="+", type=Path, default=[], help="held-out logs (other trajectories)")
     parser.add_argument("--json", dest="json_path", type=Path, default=None, help="write the result as JSON")
-    parser.add_argument("--report", type=Path, default=None, help="write report.md and PNG figures here")
+    parser.add_argument("--report", type=Path, default=None, help="write the report (Markdown) and PNG figures here")
     parser.add_argument("--catheter", default=None, help="starting catheter TOML (default configs/catheter.toml)")
     parser.add_argument("--workers", type=int, default=2, help="parallel candidate fits (default 2)")
     parser.add_argument("--blind-benchmark", action="store_true",
@@ -47,6 +48,8 @@ def run(args: argparse.Namespace) -> int:
         result = run_blind_benchmark(args.cases, args.seed, short=args.short, settings=settings,
                                      work_dir=args.work_dir, progress=_progress)
         _write_json(result, args.json_path)
+        if args.report:
+            print(f"report written to {write_blind_report(result, args.report)}")
         print(format_score(result["score"]))
         return 0
     if not args.train or not args.holdout:

@@ -1,0 +1,33 @@
+"""The blind-benchmark report (issue 6: publish the confusion matrix): Markdown and figures."""
+from crest.gap.blind_benchmark import score
+from crest.reports.blind_report import confusion_markdown, write_blind_report
+
+
+def case(index, kind, truth, predicted, predicted_shrink, oracle):
+    return {"case": index, "kind": kind, "truth": truth, "predicted": predicted or "none",
+            "predicted_effects": [predicted] if predicted else [], "predicted_shrink": predicted_shrink,
+            "oracle_shrink": oracle, "shrink_error_pp": 100 * abs(predicted_shrink - oracle),
+            "effect_rms_mm": 0.8, "noise_mm": 0.1, "above_noise": True}
+
+
+def result():
+    rows = [case(0, "single", ["backlash"], "backlash", 0.9, 0.92), case(1, "single", ["gravity"], None, 0.0, 0.1),
+            case(2, "none", [], None, 0.0, 0.0), {"case": 3, "kind": "single", "truth": ["torsion"],
+                                                 "skipped": "the plant failed in 6 draws"}]
+    return {"score": score(rows), "cases": rows,
+            "settings": {"seed": 1, "excitation": "short", "path": "virtual testbed", "seconds": 600.0}}
+
+
+def test_confusion_table_lists_true_effects_against_verdicts():
+    table = confusion_markdown(result()["score"]["confusion"]).splitlines()
+    assert table[0] == "| true \\ verdict | backlash | gravity | none |"
+    assert "| backlash | 1 | . | . |" in table and "| gravity | . | . | 1 |" in table and "| none | . | . | 1 |" in table
+
+
+def test_report_writes_markdown_and_figures(tmp_path):
+    path = write_blind_report(result(), tmp_path / "blind")
+    text = path.read_text()
+    assert "| top-1 on single effects | 50% of 2 | >= 90% |" in text
+    assert "| 3 | torsion | the plant failed in 6 draws |" in text
+    assert (tmp_path / "blind" / "confusion.png").stat().st_size > 1000
+    assert (tmp_path / "blind" / "shrink.png").stat().st_size > 1000
