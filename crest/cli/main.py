@@ -5,6 +5,7 @@ Every command runs on the virtual testbed unless --config names a real one.
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 
 from crest.cli import (bench_command, demo_command, estop_command, excite_command, fit_command, gap_command,
@@ -39,6 +40,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    # A shell starts background commands with SIGINT ignored, and Python then never raises
+    # KeyboardInterrupt. An interrupt (Ctrl-C, or `kill -INT` from a supervisor) must still stop
+    # every axis and save the log, however crest was started.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

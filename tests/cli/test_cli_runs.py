@@ -94,10 +94,12 @@ def test_bad_command_line_arguments_exit_with_usage():
     assert "invalid float value" in result.stderr
 
 
-def test_ctrl_c_stops_every_axis_and_saves_the_log(tmp_path):
+@pytest.mark.parametrize("inherited_sigint", [signal.SIG_DFL, signal.SIG_IGN])   # SIG_IGN: started by a shell
+def test_ctrl_c_stops_every_axis_and_saves_the_log(tmp_path, inherited_sigint):      # in the background
     log_path = tmp_path / "run.csv"
     process = start_crest("run", "builtin:circle", "--record", str(log_path), stdout=subprocess.PIPE,
-                          stderr=subprocess.PIPE, text=True)
+                          stderr=subprocess.PIPE, text=True,
+                          preexec_fn=lambda: signal.signal(signal.SIGINT, inherited_sigint))
     deadline = time.monotonic() + 60
     while not log_path.exists() or log_path.stat().st_size < 2000:
         assert time.monotonic() < deadline and process.poll() is None
