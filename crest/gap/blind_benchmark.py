@@ -12,10 +12,11 @@ and is scored against the draw.
 Scores: confusion matrix (true id -> verdict.effect, single and clean cases), top-1 accuracy on
 single effects (all of them, and those whose effect moves the held-out tip by at least the
 tracker noise, 3-D RMS: below it no method can be expected to see it), `none` accuracy on clean
-cases, pair accuracy (verdict.effects equals the true pair; and at least one found), and the error of the predicted shrink against the oracle shrink
-1 - RMSE(true effects added) / RMSE(baseline) on the held-out log, where the true effects are
-added to the model and calibrated with it on the training log, starting from the drawn values
-(`oracle_shrinks`; the shrink of the exact drawn plant is reported beside it).
+cases, pair accuracy (verdict.effects equals the true pair; and at least one found), and the
+error of the predicted shrink against the oracle shrink 1 - RMSE(true effects added) /
+RMSE(baseline) on the held-out log, where the true effects are added to the model and calibrated
+with it on the training log, starting from the drawn values (`oracle_shrinks`; the shrink of the
+exact drawn plant is reported beside it).
 """
 from __future__ import annotations
 
@@ -192,19 +193,19 @@ def oracle_shrinks(case: BlindCase, train: Path, holdout: Path, prior: CatheterP
     fitted (the oracle the prediction is scored against): the true effects added to the model and
     calibrated with the base parameters on the training log, from the true plant's values, as the
     diagnosis fits a candidate (where that fit ends worse on the training log than the true plant
-    itself, a local minimum, the true plant is the oracle); exact: the true plant simulated at the diagnosis' resolution (it
-    also carries the difference between that resolution and the plant's); effect size: the RMS
-    distance on the held-out log between the true plant's tip with and without its effects.
+    itself, a local minimum, the true plant is the oracle); exact: the true plant simulated at the
+    diagnosis' resolution (it also carries the difference between that resolution and the
+    plant's); effect size: the RMS distance on the held-out log between the true plant's tip with
+    and without its effects.
     """
     res = settings.resolution
     held = res.prepare(load_recordings([holdout]))
-    truth = ModelFit(catheter_for(case.plant.params, held), case.plant.zero_offsets_mm, dict(case.plant.effects))
-    fitted = calibrate(load_recordings([train]), case.plant.params, prior=prior,
-                       zero_offsets_mm=case.plant.zero_offsets_mm, effects=dict(case.plant.effects), resolution=res,
-                       max_iterations=settings.candidate_iterations)
-    train_truth = ModelFit(catheter_for(case.plant.params, load_recordings([train])), case.plant.zero_offsets_mm,
-                           dict(case.plant.effects))
-    if rmse_mm(tip_errors(train_truth, res.prepare_training(load_recordings([train])), res)) < fitted.train_rmse_mm:
+    training = load_recordings([train])
+    truth = ModelFit(catheter_for(case.plant.params, [*held, *training]), case.plant.zero_offsets_mm,
+                     dict(case.plant.effects))
+    fitted = calibrate(training, case.plant.params, prior=prior, zero_offsets_mm=case.plant.zero_offsets_mm,
+                       effects=dict(case.plant.effects), resolution=res, max_iterations=settings.candidate_iterations)
+    if rmse_mm(tip_errors(truth, res.prepare_training(training), res)) < fitted.train_rmse_mm:
         fitted = truth
     truth_errors = tip_errors(truth, held, res)
     without = tip_errors(ModelFit(truth.params, truth.zero_offsets_mm, {}), held, res)

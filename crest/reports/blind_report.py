@@ -10,27 +10,21 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-DPI = 110
+from crest.paper.figure_output import new_figure, save_png
+
 
 
 def write_blind_report(result: dict, out_dir: Path | str) -> Path:
     """Write blind_benchmark.md and the figures into out_dir (created); returns the Markdown path."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    _confusion_figure(result["score"]["confusion"]).savefig(out / "confusion.png", dpi=DPI)
-    _shrink_figure(result["cases"]).savefig(out / "shrink.png", dpi=DPI)
+    save_png(_confusion_figure(result["score"]["confusion"]), out / "confusion.png")
+    save_png(_shrink_figure(result["cases"]), out / "shrink.png")
     path = out / "blind_benchmark.md"
     path.write_text(markdown(result))
     return path
-
-
-def _figure(width_in: float, height_in: float) -> Figure:
-    figure = Figure(figsize=(width_in, height_in), layout="constrained")
-    FigureCanvasAgg(figure)
-    return figure
 
 
 def _used_labels(confusion: dict) -> tuple[list[str], list[str]]:
@@ -89,7 +83,7 @@ def markdown(result: dict) -> str:
 def _confusion_figure(confusion: dict) -> Figure:
     rows, columns = _used_labels(confusion)
     counts = np.array([[confusion[t][p] for p in columns] for t in rows], dtype=float)
-    figure = _figure(1.2 + 0.6 * len(columns), 1.0 + 0.45 * len(rows))
+    figure = new_figure(1.2 + 0.6 * len(columns), 1.0 + 0.45 * len(rows))
     ax = figure.subplots()
     ax.imshow(counts, cmap="Blues")
     ax.set_xticks(range(len(columns)), columns, rotation=45, ha="right")
@@ -104,7 +98,7 @@ def _confusion_figure(confusion: dict) -> Figure:
 
 
 def _shrink_figure(cases: list[dict]) -> Figure:
-    figure = _figure(5.0, 4.6)
+    figure = new_figure(5.0, 4.6)
     ax = figure.subplots()
     scored = [r for r in cases if "predicted_shrink" in r]
     hit = [r for r in scored if sorted(r["predicted_effects"]) == sorted(r["truth"])]

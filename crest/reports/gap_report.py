@@ -12,21 +12,14 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from crest.paper.figure_output import new_figure, save_png
 from model.gap.calibration import ModelFit
 from model.gap.recording import Recording
 from model.gap.simulation import Resolution, predict_tips
 
-DPI = 110
 GROUPS = ("articulation", "plane", "insertion", "motion", "speed", "tension", "time")
-
-
-def _figure(width_in: float, height_in: float) -> Figure:
-    figure = Figure(figsize=(width_in, height_in), layout="constrained")
-    FigureCanvasAgg(figure)
-    return figure
 
 
 def write_gap_report(result: dict, holdout: Sequence[Recording], out_dir: Path | str) -> Path:
@@ -37,9 +30,9 @@ def write_gap_report(result: dict, holdout: Sequence[Recording], out_dir: Path |
     held = resolution.prepare(holdout)
     baseline = ModelFit.from_dict(result["baseline"]["fit"])
     final = ModelFit.from_dict(result["verdict"]["fit"])
-    _region_figure(result).savefig(out / "residual_by_region.png", dpi=DPI)
-    _trace_figure(held, baseline, final, result["verdict"], resolution).savefig(out / "tip_traces.png", dpi=DPI)
-    _candidate_figure(result).savefig(out / "candidates.png", dpi=DPI)
+    save_png(_region_figure(result), out / "residual_by_region.png")
+    save_png(_trace_figure(held, baseline, final, result["verdict"], resolution), out / "tip_traces.png")
+    save_png(_candidate_figure(result), out / "candidates.png")
     path = out / "report.md"
     path.write_text(markdown(result))
     return path
@@ -49,7 +42,7 @@ def _region_figure(result: dict) -> Figure:
     where = result["where"]
     after = {row["region"]: row["after_mm"] for row in result["verdict"]["shrink_by_region"]}
     groups = [g for g in GROUPS if any(row["group"] == g for row in where)]
-    figure = _figure(11.0, 2.3 * len(groups))
+    figure = new_figure(11.0, 2.3 * len(groups))
     axes = figure.subplots(len(groups), 1, squeeze=False)[:, 0]
     for ax, group in zip(axes, groups):
         rows = [row for row in where if row["group"] == group]
@@ -75,7 +68,7 @@ def _trace_figure(held: Sequence[Recording], baseline: ModelFit, final: ModelFit
     before = predict_tips(baseline.params, baseline.terms(), np.asarray(baseline.zero_offsets_mm), recording,
                           resolution)
     after = predict_tips(final.params, final.terms(), np.asarray(final.zero_offsets_mm), recording, resolution)
-    figure = _figure(11.0, 7.0)
+    figure = new_figure(11.0, 7.0)
     axes = figure.subplots(3, 1, sharex=True)
     label = "+".join(verdict["effects"]) or "none (= baseline)"
     for k, (ax, axis) in enumerate(zip(axes, "xyz")):
@@ -91,7 +84,7 @@ def _trace_figure(held: Sequence[Recording], baseline: ModelFit, final: ModelFit
 
 def _candidate_figure(result: dict) -> Figure:
     rows = [c for c in result["candidates"] if c["holdout_rmse_mm"] is not None]
-    figure = _figure(8.0, 3.5)
+    figure = new_figure(8.0, 3.5)
     ax = figure.subplots()
     ax.barh([c["effect"] for c in rows][::-1], [c["holdout_rmse_mm"] for c in rows][::-1], color="tab:blue")
     ax.axvline(result["baseline"]["holdout_rmse_mm"], color="tab:red", label="baseline")

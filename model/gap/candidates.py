@@ -149,9 +149,10 @@ def run_task(task: FitTask) -> CandidateResult:
         start = ModelFit(start.params, start.zero_offsets_mm, fixed)
     fit = calibrate(task.train, start.params, prior=task.prior, zero_offsets_mm=start.zero_offsets_mm,
                     effects=start.effects, resolution=task.resolution, max_iterations=task.iterations)
-    # the fit's end point and its ablation may be where the solver crawls: give up on them (inf) as a fit does
+    # the fit's end point and its ablation may be where the solver crawls: give up on them (inf) as a fit
+    # does; a run costs in proportion to its samples, so the held-out limit scales the training one
     train_limit_s = _time_limit_s(task.start, train, task.resolution)
-    holdout_limit_s = _time_limit_s(task.start, task.holdout, task.resolution)
+    holdout_limit_s = max(train_limit_s * sum(map(len, task.holdout)) / sum(map(len, train)), MIN_TIME_LIMIT_S)
     errors = tuple(tip_errors(fit, task.holdout, task.resolution, holdout_limit_s))
     result = evaluate(tuple(task.effects), fit, errors, task.baseline_errors, task.baseline_rmse_mm)
     ablated = ModelFit(fit.params, fit.zero_offsets_mm, {})
