@@ -13,8 +13,9 @@ import numpy as np
 
 from model.effect_terms import EffectTerms
 from model.params import CatheterParams
-from model.quasi_static_kernel import (N_PARAMS, N_SCALARS, P_ALPHA, P_EA, P_EAT, P_EI, P_FSC, P_MU, P_R,
-                                       P_RHO, P_SIGMA, S_ITERATIONS, S_UNCONVERGED, run_path)
+from model.quasi_static_kernel import (MAX_NEWTON_ITERATIONS, N_PARAMS, N_SCALARS, P_ALPHA, P_EA, P_EAT, P_EI,
+                                       P_FSC, P_MU, P_R, P_RHO, P_SIGMA, S_ITERATIONS, S_UNCONVERGED,
+                                       run_path)
 
 MIN_ELEMENTS = 4
 
@@ -73,21 +74,26 @@ class DahlCatheter:
 
     Motion is quasi-static: each input change is followed in sub-steps of at most
     `max_tendon_step_mm` of tendon and `max_insertion_step_mm` of insertion, so the friction
-    history follows the path.
+    history follows the path; a sub-step whose Newton solve needs more than
+    `max_newton_iterations` is retried in halves.
     """
 
     def __init__(self, params: CatheterParams, n_elements: int = 20, effects: EffectTerms = EffectTerms(),
-                 max_tendon_step_mm: float = 0.05, max_insertion_step_mm: float = 0.5):
+                 max_tendon_step_mm: float = 0.05, max_insertion_step_mm: float = 0.5,
+                 max_newton_iterations: int = MAX_NEWTON_ITERATIONS):
         if isinstance(n_elements, bool) or not isinstance(n_elements, (int, np.integer)) \
                 or n_elements < MIN_ELEMENTS:
             raise ValueError(f"n_elements must be an integer >= {MIN_ELEMENTS}, got {n_elements!r}")
         if not (max_tendon_step_mm > 0 and max_insertion_step_mm > 0):
             raise ValueError("max_tendon_step_mm and max_insertion_step_mm must be > 0")
+        if not max_newton_iterations >= 1:
+            raise ValueError(f"max_newton_iterations must be >= 1, got {max_newton_iterations!r}")
         self.params = params
         self.n_elements = int(n_elements)
         self.effects = effects
         self.max_tendon_step_mm = float(max_tendon_step_mm)
         self.max_insertion_step_mm = float(max_insertion_step_mm)
+        self.max_newton_iterations = int(max_newton_iterations)
         self._kernel_params = self._pack(params)
         self._kernel_effects = effects.kernel_vector()
         self._tracker_offset_mm = np.asarray(effects.tracker_offset_mm, dtype=float)
@@ -177,7 +183,7 @@ class DahlCatheter:
         s = self.state
         tips = np.empty((len(tendons), 3))
         run_path(tendons, insertion, dt_s, self.max_tendon_step_mm, self.max_insertion_step_mm,
-                 self._kernel_params, self._kernel_effects, self._point_loads, s.applied_tendon_mm, s.applied_insertion_mm,
+                 self.max_newton_iterations, self._kernel_params, self._kernel_effects, self._point_loads, s.applied_tendon_mm, s.applied_insertion_mm,
                  s.friction_n, s.sliding_mm, s.last_step_mm, s.tension_n, s.bend_rad, s.compression_mm,
                  s.tip_tension_n, s.drive_tension_n, s.slack, s.points_mm, s.frames, s.diagnostics, tips)
         if not (np.isfinite(tips).all() and np.isfinite(s.friction_n).all()):
@@ -248,5 +254,5 @@ class DahlCatheter:
 
     @property
     def solver_iterations(self) -> tuple[int, int]:
-        """(secant iterations in total, steps that hit the iteration limit) since reset."""
+        """(Newton iterations in total, steps that hit the iteration limit) since reset."""
         return int(self.state.diagnostics[S_ITERATIONS]), int(self.state.diagnostics[S_UNCONVERGED])

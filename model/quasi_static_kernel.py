@@ -67,8 +67,9 @@ S_ITERATIONS = 0    # Newton iterations used in total
 S_UNCONVERGED = 1   # steps that hit the iteration limit
 N_SCALARS = 2
 
-MAX_NEWTON_ITERATIONS = 12
+MAX_NEWTON_ITERATIONS = 12   # default Newton iterations of a sub-step before it is retried in halves
 MAX_HALVINGS = 10   # an unconverged sub-step is retried in halves, down to 1/1024 of it
+MAX_TENSION_STEP_N = 1.0  # a sub-step switching slack tendons and a drive tension by more is retried in halves
 FORCE_TOLERANCE_N = 1e-4  # exact vs linearised Dahl force per element; 1e-4 N moves the tip < 1 um
 
 
@@ -376,12 +377,12 @@ def make_workspace(n):
 @kernel
 def quasi_static_step(u, length, rate_scale, params, effects, point_loads, friction, sliding, last_step, tension,
                       bend, compression, tip_tension, drive_tension, slack, points, frames, scalars, work,
-                      commit_unconverged):
+                      max_iterations, commit_unconverged):
     """Advance the catheter state to equilibrium at tendon input u [mm] and free length [mm].
 
     `rate_scale[k]` multiplies tendon k's friction strength (rate friction, 1 without it).
     `work` is scratch space from make_workspace. Returns
-    True when Newton converged; the state arrays are then updated in place. An unconverged
+    True when Newton converged within max_iterations; the state arrays are then updated in place. An unconverged
     step leaves the state untouched (the caller retries with a smaller step) unless
     `commit_unconverged`.
     """
@@ -422,7 +423,7 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
     crossed[:, :] = False
     slack_before[:] = slack
     converged = False
-    for iteration in range(MAX_NEWTON_ITERATIONS):
+    for iteration in range(max_iterations):
         scalars[S_ITERATIONS] += 1.0
         _sweep(n, h, params, arm, cos_phi, sin_phi, ext_bend, f0, kx, gt, gth, bend_dir, xref, tref, slack,
                lin_force, dist_force, dist_short, sweep_scratch)
@@ -513,6 +514,21 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
         if finite and worst < FORCE_TOLERANCE_N:
             converged = True
             break
+    switched = False
+    for k in range(4):
+        switched = switched or slack[k] != slack_before[k]
+    if converged and switched and not commit_unconverged:
+        # A converged solve may still have switched to another equilibrium: at a coarse sub-step
+        # the slack/taut set can flip so that a loaded tendon drops its tension at once (one
+        # recording: 6.5 N to 0 N and an 18 mm tip jump where 0.05 mm sub-steps move 0.3 mm).
+        # A sub-step that changes the slack set and a drive tension by more than
+        # MAX_TENSION_STEP_N is retried in halves.
+        for k in range(4):
+            drive = tip_tension[k]
+            for i in range(n):
+                drive += new_force[k, i]
+            if abs(drive - drive_tension[k]) > MAX_TENSION_STEP_N:
+                converged = False
     if not converged:
         if not commit_unconverged:
             slack[:] = slack_before
@@ -585,7 +601,7 @@ def remap_to_length(old_length, new_length, friction, sliding, last_step, tensio
 
 
 @kernel
-def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_step_mm, params, effects,
+def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_step_mm, max_iterations, params, effects,
              point_loads, applied_tendon_mm, applied_insertion_mm, friction, sliding, last_step, tension, bend,
              compression, tip_tension, drive_tension, slack, points, frames, scalars, tips_out):
     """Drive the model along a sampled input path; tips_out[t] is the tip after sample t.
@@ -593,7 +609,8 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
     Inputs pass the drive-train plays first (backlash per tendon, tube play on insertion).
     point_loads (K, 4): external point forces (fx, fy, fz [N], distance from the tip [mm]).
     Each sample is split into sub-steps of at most max_tendon_step_mm / max_insertion_step_mm
-    so that the friction state follows the path (history) and not just its end point.
+    so that the friction state follows the path (history) and not just its end point; a sub-step
+    whose Newton solve needs more than max_iterations is retried in halves.
 
     Rate friction scales tendon k's friction strength by s_k = 1 + c_rate*|v_k| over the
     sample, v_k = (u_k(t) - u_k(t-1)) / dt_s its pull speed past the drive-train play (0 for
@@ -635,7 +652,7 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
             remap_to_length(previous_length, length, friction, sliding, last_step, tension)
             if quasi_static_step(u, length, rate_scale, params, effects, point_loads, friction, sliding,
                                  last_step, tension, bend, compression, tip_tension, drive_tension, slack, points,
-                                 frames, scalars, work, fraction <= smallest):
+                                 frames, scalars, work, max_iterations, fraction <= smallest):
                 done = w
                 fraction = min(2.0 * fraction, 1.0 / n_sub)
             else:

@@ -6,6 +6,8 @@ hidden effect) is not an input.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor
+from contextlib import nullcontext
 from pathlib import Path
 
 from crest.gap.log_recordings import load_recordings
@@ -26,8 +28,10 @@ def calibrate_logs(train: Sequence[Path | str], catheter_toml: Path | str | None
     prior = prior_catheter(catheter_toml)
     recordings = load_recordings(train)
     say = progress or (lambda message: None)
-    return calibrate_base(recordings, prior, resolution=settings.resolution, max_iterations=settings.baseline_iterations,
-                          on_evaluation=lambda n: say(f"fit: {n} model runs") if n % 50 == 0 else None)
+    with ProcessPoolExecutor(settings.workers) if settings.workers > 1 else nullcontext() as pool:
+        return calibrate_base(recordings, prior, resolution=settings.resolution,
+                              max_iterations=settings.baseline_iterations, executor=pool,
+                              on_fit=lambda done, total: say(f"fit: {done}/{total} starts fitted"))
 
 
 def diagnose_logs(train: Sequence[Path | str], holdout: Sequence[Path | str],

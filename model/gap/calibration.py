@@ -8,8 +8,12 @@ with the model driven by the measured tendon and insertion positions (scipy.opti
 trust-region reflective, forward-difference Jacobian), warm-started from the given parameters.
 
 Between good starting parameters the cost has ridges (where a parameter change flips a tendon
-between slack and taut at some moment), so a fit can stall in a valley: `calibrate_base` explores
-several starts (`model.gap.starting_points.base_starts`) with short fits and fits the best to the end.
+between slack and taut at some moment, or friction holds a bend in one branch and not in the
+other), so a fit can stall in a valley. `calibrate_base` fits from several starts
+(`model.gap.starting_points`: the prior at a few friction coefficients, and the best points of
+a coarse grid by one model run each) and keeps the best end. Which start ends best is not
+predictable early: on one clean recording the start best after three cost evaluations ended
+at 0.52 mm, another at 0.26 mm.
 
 Uncertainty from the Jacobian J at the solution (in the optimisation variables z):
 
@@ -22,10 +26,10 @@ trade off (e.g. EI and mu: friction is proportional to mu * tension and tension 
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import Executor
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -34,8 +38,8 @@ from model.dahl_catheter import ModelSolverError
 from model.effects.catalog import combined_terms, effect
 from model.gap.free_parameters import ParameterLayout, base_values
 from model.gap.recording import Recording
-from model.gap.simulation import Resolution, SimulationTooSlow, catheter_for, predict_tips
-from model.gap.starting_points import base_starts
+from model.gap.simulation import Resolution, SimulationTooSlow, catheter_for, predict_tips, solver_work
+from model.gap.starting_points import base_grid, base_starts
 from model.params import CatheterParams
 
 DIFF_STEP = 0.02       # relative finite-difference step: far above the kernel's ~1 um solver noise
@@ -48,11 +52,13 @@ RESTART_GAIN = 0.01
 XTOL_REACHED = 3       # least_squares status
 DIVERGED_RESIDUAL_MM = 1e3
 # Where the solver crawls (e.g. very stiff Dahl friction), a run is abandoned and scored as diverged
-# once it takes SLOW_RUN_FACTOR times the CPU time of the run at the start (and at least MIN_TIME_LIMIT_S).
-# CPU time, not wall time: on a busy machine a wall-clock limit would change the fit's result.
+# once it takes SLOW_RUN_FACTOR times the solver iterations of the run at the start (and at least
+# MIN_ITERATION_LIMIT). Iterations, not time: a time limit made the result depend on the machine's load.
 SLOW_RUN_FACTOR = 8.0
-MIN_TIME_LIMIT_S = 0.1
-EXPLORE_ITERATIONS = 3  # cost evaluations of each start's exploratory fit (`best_start`)
+MIN_ITERATION_LIMIT = 1000
+EXPLORE_ITERATIONS = 3  # cost evaluations of each start's exploratory fit (`explore`)
+GRID_STARTS = 3         # the best points of `base_grid` (one model run each) that `calibrate_base` fits from
+ZERO_OFFSETS_MM = (0.0, 0.0, 0.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -124,10 +130,10 @@ def rmse_mm(errors: Sequence[np.ndarray]) -> float:
 
 
 def tip_errors(fit: ModelFit, recordings: Sequence[Recording], resolution: Resolution,
-               time_limit_s: float | None = None) -> list[np.ndarray]:
+               iteration_limit: int | None = None) -> list[np.ndarray]:
     """Model minus measured tip [n_valid, 3] per recording (recordings already at the fit resolution).
 
-    Where the model diverges at these parameters, or a recording's run exceeds time_limit_s,
+    Where the model diverges at these parameters, or a recording's run exceeds iteration_limit,
     the errors are infinite.
     """
     terms = fit.terms()
@@ -135,7 +141,7 @@ def tip_errors(fit: ModelFit, recordings: Sequence[Recording], resolution: Resol
     errors = []
     for r in recordings:
         try:
-            tips = predict_tips(fit.params, terms, zero, r, resolution, time_limit_s)
+            tips = predict_tips(fit.params, terms, zero, r, resolution, iteration_limit)
         except (ModelSolverError, SimulationTooSlow):
             tips = np.full(r.tip_mm.shape, np.inf)
         error = (tips - r.tip_mm)[r.valid]
@@ -153,12 +159,12 @@ class _Objective:
     zero_start: np.ndarray
     prepared: list[Recording]
     resolution: Resolution
-    time_limit_s: float | None = None
+    iteration_limit: int | None = None
 
     def __call__(self, z: np.ndarray) -> np.ndarray:
         params, zero, values = self.layout.unpack(z, self.start, self.zero_start)
         out = np.concatenate(tip_errors(ModelFit(params, tuple(zero), values), self.prepared, self.resolution,
-                                        self.time_limit_s)).ravel()
+                                        self.iteration_limit)).ravel()
         if not np.all(np.isfinite(out)):   # the solver failed at these parameters: make them unattractive
             out = np.full_like(out, DIVERGED_RESIDUAL_MM)
         return out
@@ -168,7 +174,7 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
               zero_offsets_mm: Sequence[float] = (0.0, 0.0, 0.0, 0.0),
               effects: Mapping[str, Sequence[float]] | None = None, fit_base: bool = True,
               resolution: Resolution = Resolution(), max_iterations: int = 30, restarts: int = MAX_RESTARTS,
-              executor: Executor | None = None, on_evaluation: Callable[[int], None] | None = None) -> ModelFit:
+              executor: Executor | None = None) -> ModelFit:
     """Fit the base parameters (unless fit_base is False) and the given effects' parameters.
 
     max_iterations bounds the cost evaluations of each least_squares run (not counting the
@@ -186,7 +192,8 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
     effects = {effect_id: tuple(values) for effect_id, values in (effects or {}).items()}
     layout = ParameterLayout(prior, tuple(effects), fit_base)
     zero_start = np.asarray(zero_offsets_mm, dtype=float)
-    objective = _Objective(layout, start, zero_start, prepared, resolution)
+    objective = _Objective(layout, start, zero_start, prepared, resolution,
+                           iteration_limit(ModelFit(start, tuple(zero_start), effects), prepared, resolution))
     runs = 0
     costs: list[float] = []
     last: list[tuple[bytes, np.ndarray]] = []
@@ -195,14 +202,9 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
         nonlocal runs
         runs += 1
         costs.append(0.5 * float(out @ out))
-        if on_evaluation is not None:
-            on_evaluation(runs)
 
     def residuals(z: np.ndarray) -> np.ndarray:
-        clock = time.process_time()
         out = objective(z)
-        if objective.time_limit_s is None:   # the first run, at the start: the yardstick for a normal run
-            objective.time_limit_s = max(SLOW_RUN_FACTOR * (time.process_time() - clock), MIN_TIME_LIMIT_S)
         count(out)
         last[:] = [(z.tobytes(), out)]
         return out
@@ -240,25 +242,48 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
                     train_rmse_mm=train_rmse, model_runs=runs)
 
 
-def best_start(recordings: Sequence[Recording], starts: Sequence[ModelFit], prior: CatheterParams,
-               resolution: Resolution, executor: Executor | None = None) -> ModelFit:
+def probe_costs(fits: Sequence[ModelFit], recordings: Sequence[Recording], resolution: Resolution) -> list[float]:
+    """Training RMSE of each fit (recordings at the fit resolution), one model run each; a run taking
+    over SLOW_RUN_FACTOR x the first one's solver iterations is given up (inf)."""
+    limit = iteration_limit(fits[0], recordings, resolution)
+    return [rmse_mm(tip_errors(fit, recordings, resolution, limit)) for fit in fits]
+
+
+def iteration_limit(fit: ModelFit, recordings: Sequence[Recording], resolution: Resolution) -> int:
+    """SLOW_RUN_FACTOR x the solver iterations of `fit` (a model that runs normally) on the recordings."""
+    work = solver_work(fit.params, fit.terms(), np.asarray(fit.zero_offsets_mm), recordings, resolution)
+    return max(int(SLOW_RUN_FACTOR * work), MIN_ITERATION_LIMIT)
+
+
+def explore(recordings: Sequence[Recording], starts: Sequence[ModelFit], prior: CatheterParams,
+            resolution: Resolution, executor: Executor | None = None) -> list[ModelFit]:
     """The short fit (EXPLORE_ITERATIONS cost evaluations, no restarts) of each start, base parameters
-    and effects, that reaches the lowest training RMSE."""
+    and effects, lowest training RMSE first."""
     explored = [calibrate(recordings, start.params, prior=prior, zero_offsets_mm=start.zero_offsets_mm,
                           effects=start.effects, resolution=resolution, max_iterations=EXPLORE_ITERATIONS, restarts=0,
                           executor=executor) for start in starts]
-    return min(explored, key=lambda fit: fit.train_rmse_mm)
+    return sorted(explored, key=lambda fit: fit.train_rmse_mm)
 
 
 def calibrate_base(recordings: Sequence[Recording], prior: CatheterParams, *, resolution: Resolution = Resolution(),
                    max_iterations: int = 30, executor: Executor | None = None,
-                   on_evaluation: Callable[[int], None] | None = None) -> ModelFit:
-    """The base model (no effects) fitted from the best of `base_starts(prior)` (see module doc)."""
-    starts = [ModelFit(params, (0.0, 0.0, 0.0, 0.0), {}) for params in base_starts(prior)]
-    start = best_start(recordings, starts, prior, resolution, executor)
-    return calibrate(recordings, start.params, prior=prior, zero_offsets_mm=start.zero_offsets_mm,
-                     resolution=resolution, max_iterations=max_iterations, executor=executor,
-                     on_evaluation=on_evaluation)
+                   on_fit: Callable[[int, int], None] | None = None) -> ModelFit:
+    """The base model (no effects) fitted from each of `base_starts(prior)` and the GRID_STARTS best
+    points of `base_grid(prior)` (see module doc): the fit with the lowest training RMSE.
+
+    executor: runs the fits in parallel. on_fit(done, total) after each fit.
+    """
+    prepared = resolution.prepare_training(recordings)
+    grid = [ModelFit(params, ZERO_OFFSETS_MM, {}) for params in base_grid(catheter_for(prior, prepared))]
+    costs = probe_costs(grid, prepared, resolution)
+    starts = base_starts(prior) + [grid[i].params for i in np.argsort(costs, kind="stable")[:GRID_STARTS]]
+    fit_from = partial(calibrate, recordings, prior=prior, resolution=resolution, max_iterations=max_iterations)
+    fits = []
+    for fit in (executor.map(fit_from, starts) if executor is not None else map(fit_from, starts)):
+        fits.append(fit)
+        if on_fit is not None:
+            on_fit(len(fits), len(starts))
+    return min(fits, key=lambda fit: fit.train_rmse_mm)
 
 
 def _statistics(jac: np.ndarray, fun: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:

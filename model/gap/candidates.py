@@ -30,8 +30,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from model.effects.catalog import effect
-from model.gap.calibration import (MIN_TIME_LIMIT_S, SLOW_RUN_FACTOR, ModelFit, best_start, calibrate, rmse_mm,
-                                   tip_errors)
+from model.gap.calibration import (MIN_ITERATION_LIMIT, ModelFit, calibrate, explore, iteration_limit,
+                                   probe_costs, rmse_mm, tip_errors)
 from model.gap.recording import Recording
 from model.gap.simulation import Resolution, catheter_for
 from model.gap.starting_points import probe_values, start_values
@@ -81,6 +81,8 @@ class CandidateResult:
                 "holdout_rmse_mm": number(self.holdout_rmse_mm), "shrink": number(self.shrink),
                 "signature_match": self.signature_match, "score": number(self.score),
                 "ablated_train_rmse_mm": number(self.ablated_train_rmse_mm),
+                "ablated_holdout_rmse_mm": number(rmse_mm(self.ablated_holdout_errors))
+                if self.ablated_holdout_errors else None,
                 "diverged": not np.isfinite(self.holdout_rmse_mm), "flags": list(self.fit.flags),
                 "model_runs": self.fit.model_runs, "seconds": self.seconds}
 
@@ -140,39 +142,26 @@ def run_task(task: FitTask) -> CandidateResult:
         for base, zeros in ((start.params, start.zero_offsets_mm), (start.params, (0.0, 0.0, 0.0, 0.0)),
                             (catheter_for(task.prior, train), (0.0, 0.0, 0.0, 0.0))):
             probed = [with_last(base, zeros, probe) for probe in probes]
-            candidates.append(probed[int(np.argmin(_probe_costs(probed, train, task.resolution)))])
-        start = best_start(task.train, candidates, task.prior, task.resolution)
+            candidates.append(probed[int(np.argmin(probe_costs(probed, train, task.resolution)))])
+        start = explore(task.train, candidates, task.prior, task.resolution)[0]
     elif task.mode == PROBE:
         probed = [with_last(start.params, start.zero_offsets_mm, probe) for probe in probes]
-        start = probed[int(np.argmin(_probe_costs(probed, train, task.resolution)))]
+        start = probed[int(np.argmin(probe_costs(probed, train, task.resolution)))]
     else:
         start = ModelFit(start.params, start.zero_offsets_mm, fixed)
     fit = calibrate(task.train, start.params, prior=task.prior, zero_offsets_mm=start.zero_offsets_mm,
                     effects=start.effects, resolution=task.resolution, max_iterations=task.iterations)
     # the fit's end point and its ablation may be where the solver crawls: give up on them (inf) as a fit
     # does; a run costs in proportion to its samples, so the held-out limit scales the training one
-    train_limit_s = _time_limit_s(task.start, train, task.resolution)
-    holdout_limit_s = max(train_limit_s * sum(map(len, task.holdout)) / sum(map(len, train)), MIN_TIME_LIMIT_S)
-    errors = tuple(tip_errors(fit, task.holdout, task.resolution, holdout_limit_s))
+    train_limit = iteration_limit(task.start, train, task.resolution)
+    holdout_limit = max(int(train_limit * sum(map(len, task.holdout)) / sum(map(len, train))), MIN_ITERATION_LIMIT)
+    errors = tuple(tip_errors(fit, task.holdout, task.resolution, holdout_limit))
     result = evaluate(tuple(task.effects), fit, errors, task.baseline_errors, task.baseline_rmse_mm)
     ablated = ModelFit(fit.params, fit.zero_offsets_mm, {})
     return dataclasses.replace(
         result, seconds=time.perf_counter() - clock,
-        ablated_train_rmse_mm=rmse_mm(tip_errors(ablated, train, task.resolution, train_limit_s)),
-        ablated_holdout_errors=tuple(tip_errors(ablated, task.holdout, task.resolution, holdout_limit_s)))
-
-
-def _time_limit_s(fit: ModelFit, recordings: Sequence[Recording], resolution: Resolution) -> float:
-    """SLOW_RUN_FACTOR x the CPU time of `fit` (a model that runs normally) on the recordings."""
-    clock = time.process_time()
-    tip_errors(fit, recordings, resolution)
-    return max(SLOW_RUN_FACTOR * (time.process_time() - clock), MIN_TIME_LIMIT_S)
-
-
-def _probe_costs(fits: Sequence[ModelFit], train: Sequence[Recording], resolution: Resolution) -> list[float]:
-    """Training RMSE of each fit; runs taking over SLOW_RUN_FACTOR x the first one's CPU time are given up (inf)."""
-    limit = _time_limit_s(fits[0], train, resolution)
-    return [rmse_mm(tip_errors(fit, train, resolution, limit)) for fit in fits]
+        ablated_train_rmse_mm=rmse_mm(tip_errors(ablated, train, task.resolution, train_limit)),
+        ablated_holdout_errors=tuple(tip_errors(ablated, task.holdout, task.resolution, holdout_limit)))
 
 
 def evaluate(effects: tuple[str, ...], fit: ModelFit, errors: Sequence[np.ndarray],

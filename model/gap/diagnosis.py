@@ -4,10 +4,11 @@
 2. Where: break the held-out residual down by region (`regions`) and compute its signatures.
 3. Which: fit every candidate effect (and a plain refit, the control) in parallel, rank them by
    held-out score (`candidates`); the best is chosen only if it removes more than noise can
-   explain, else the verdict is `none` with a description of the unexplained residual. A second
-   effect is added by greedy forward selection among the next best candidates that are
-   meaningful on their own, again only if the pair is meaningful against the control: the
-   chosen effect refitted alone with the same budget.
+   explain, both against the baseline and against its own ablation (the same fit with the
+   effect switched off), else the verdict is `none` with a description of the unexplained
+   residual. A second effect is added by greedy forward selection among the next best candidates
+   found on their own, again only if the pair is meaningful against the control: the chosen
+   effect refitted alone with the same budget.
 4. How far: held-out RMSE before and after, shrink overall and per region, and how the base
    parameters moved when the effect was added.
 The result is a plain, JSON-able dict (see `diagnose`).
@@ -78,7 +79,7 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
     say(f"baseline: calibrating on {len(train)} training recording(s)")
     baseline = calibrate_base(train, prior, resolution=res, max_iterations=settings.baseline_iterations,
                               executor=pool,
-                              on_evaluation=lambda n: say(f"baseline: {n} model runs") if n % 50 == 0 else None)
+                              on_fit=lambda done, total: say(f"baseline: {done}/{total} starts fitted"))
     held = res.prepare(holdout)
     base_errors = _holdout_errors(baseline, held, res)
     base_rmse = rmse_mm(base_errors)
@@ -111,22 +112,28 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
     singles = ranked(singles)
     timing["candidates"] = time.perf_counter() - clock - sum(timing.values())
 
+    def is_found(result: CandidateResult) -> bool:
+        """Meaningful against the baseline, and against its own ablation: the effect, not the refit
+        of the base parameters that came with it, removes the error (a candidate whose effect
+        ended switched off can still beat a baseline that generalises worse)."""
+        return (is_meaningful(base_rmse, result.holdout_rmse_mm, noise)
+                and is_meaningful(rmse_mm(result.ablated_holdout_errors), result.holdout_rmse_mm, noise))
+
     chosen: list[CandidateResult] = []
     pairs: list[CandidateResult] = []
-    if is_meaningful(base_rmse, singles[0].holdout_rmse_mm, noise) and settings.pair_candidates == 0:
-        chosen = [singles[0]]
-    elif is_meaningful(base_rmse, singles[0].holdout_rmse_mm, noise):
-        best = singles[0]
-        # second effects: the next best singles that are meaningful on their own
-        others = [r.effects[0] for r in singles[1:] if is_meaningful(base_rmse, r.holdout_rmse_mm, noise)]
-        others = others[:settings.pair_candidates]
+    eligible = [r for r in singles if is_found(r)]
+    if eligible and settings.pair_candidates == 0:
+        chosen = [eligible[0]]
+    elif eligible:
+        best = eligible[0]
+        # second effects: the next best singles that are found on their own
+        others = [r.effects[0] for r in eligible[1:settings.pair_candidates + 1]]
         say(f"pairs: {best.effects[0]} alone (control) and with each of {', '.join(others) or 'no other'}")
         continued, *pairs = run_tasks([task(dict(best.fit.effects), best.fit, CONTINUE)]
                                       + [task({**best.fit.effects, other: start_values(other)}, best.fit, PROBE)
                                          for other in others], pool)
         if continued.fit.train_rmse_mm < best.fit.train_rmse_mm:   # the control got further: it is the single
-            best = replace(continued, seconds=best.seconds + continued.seconds)
-            singles[0] = best
+            singles[singles.index(best)] = best = replace(continued, seconds=best.seconds + continued.seconds)
         chosen = [best]
         pairs = ranked(pairs)
         if pairs and is_meaningful(best.holdout_rmse_mm, pairs[0].holdout_rmse_mm, noise):
@@ -172,7 +179,7 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
         "where": where,
         "concentrated": [row["region"] for row in concentrated(where)],
         "signatures": signature,
-        "candidates": [r.as_dict() for r in singles],
+        "candidates": [{**r.as_dict(), "found": is_found(r)} for r in singles],
         "pairs": [r.as_dict() for r in pairs],
         "verdict": verdict,
         "settings": {**asdict(settings), "train": [r.name for r in train], "holdout": [r.name for r in holdout],

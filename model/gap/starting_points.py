@@ -13,6 +13,7 @@ from model.effects.catalog import effect
 from model.params import CatheterParams
 
 MU_START_FACTORS = (0.5, 1.0, 1.75)
+GRID_FACTORS = (0.6, 1.0, 1.6)    # EI, and mu and Fsc, of `base_grid` relative to the prior
 
 
 def base_starts(prior: CatheterParams) -> list[CatheterParams]:
@@ -23,6 +24,18 @@ def base_starts(prior: CatheterParams) -> list[CatheterParams]:
     ridge, while fits from 0.1 and 0.35 reached it.
     """
     return [prior.replace(mu=factor * prior.mu) for factor in MU_START_FACTORS]
+
+
+def base_grid(prior: CatheterParams) -> list[CatheterParams]:
+    """The prior with EI, mu and Fsc each at GRID_FACTORS of its value: 27 catheters, worth one model run each.
+
+    A catheter whose stiffness is far from the prior's (a real catheter, or one from another
+    batch) can sit behind a ridge from all of `base_starts`: one of them fitted a clean recording
+    to 1.06 mm where a fit from EI 0.6x reached the 0.17 mm noise floor.
+    """
+    return [prior.replace(bending_stiffness_nmm2=ei * prior.bending_stiffness_nmm2, mu=mu * prior.mu,
+                          fsc_n_per_mm=fsc * prior.fsc_n_per_mm)
+            for ei in GRID_FACTORS for mu in GRID_FACTORS for fsc in GRID_FACTORS]
 
 
 def start_values(effect_id: str) -> tuple[float, ...]:
