@@ -183,7 +183,8 @@ class DahlCatheter:
         s = self.state
         tips = np.empty((len(tendons), 3))
         run_path(tendons, insertion, dt_s, self.max_tendon_step_mm, self.max_insertion_step_mm,
-                 self.max_newton_iterations, self._kernel_params, self._kernel_effects, self._point_loads, s.applied_tendon_mm, s.applied_insertion_mm,
+                 self.max_newton_iterations, self._kernel_params, self._kernel_effects, self._point_loads,
+                 s.applied_tendon_mm, s.applied_insertion_mm,
                  s.friction_n, s.sliding_mm, s.last_step_mm, s.tension_n, s.bend_rad, s.compression_mm,
                  s.tip_tension_n, s.drive_tension_n, s.slack, s.points_mm, s.frames, s.diagnostics, tips)
         if not (np.isfinite(tips).all() and np.isfinite(s.friction_n).all()):

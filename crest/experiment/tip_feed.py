@@ -9,19 +9,27 @@ In simulated time (`sample_period_s` given) the loop runs faster than the wall-c
 the feed asks for a fresh frame once per tracker period of simulated time and waits for it:
 the samples then describe the simulated catheter at that instant, as a real tracker would. The
 first frame to arrive may have been requested before the last cycle (the tracker thread polls
-on its own), so the feed waits for the one after it.
+on its own), so the feed waits for the one after it. A busy host may delay a frame by more than
+a tracker period of wall time; that is not tracker loss, so the feed keeps waiting while the
+driver still reports TRACKING (up to STALLED_TRACKER_TIMEOUT_S). Once the driver reports the
+link lost, the poll returns None at once and the simulated age grows.
 """
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 
 from control import TipMeasurement
-from crest.tracker import AuroraDriver
+from crest.tracker import AuroraDriver, TipSample, TrackerState
 
 
-FRESH_SAMPLE_TIMEOUT_S = 0.2
+FRESH_SAMPLE_WAIT_S = 0.2
+"""One wait for a new frame, after which the feed checks the driver's link state."""
+
+STALLED_TRACKER_TIMEOUT_S = 5.0
+"""Longest wall-clock wait for one frame while the driver still reports TRACKING."""
 
 
 class TipFeed:
@@ -45,11 +53,9 @@ class TipFeed:
             return None
         else:
             self._next_sample_s = now_s + self.sample_period_s
-            try:
-                self.tracker.wait_next(FRESH_SAMPLE_TIMEOUT_S)        # possibly requested before now
-                sample = self.tracker.wait_next(FRESH_SAMPLE_TIMEOUT_S)
-            except TimeoutError:       # the link is down: the age keeps growing
+            if self._wait_next() is None:          # possibly requested before now
                 return None
+            sample = self._wait_next()
         if sample is None or sample.frame == self._frame:
             return None
         self._frame = sample.frame
@@ -59,6 +65,16 @@ class TipFeed:
         self.latest_tip_mm = np.asarray(sample.tip_mm, dtype=float)
         self._last_valid_s = now_s
         return TipMeasurement(self.latest_tip_mm, now_s)
+
+    def _wait_next(self) -> TipSample | None:
+        """The next frame in wall time; None once the driver reports the link lost (or it stalls)."""
+        deadline_s = time.monotonic() + STALLED_TRACKER_TIMEOUT_S
+        while True:
+            try:
+                return self.tracker.wait_next(FRESH_SAMPLE_WAIT_S)
+            except TimeoutError:
+                if self.tracker.state is not TrackerState.TRACKING or time.monotonic() > deadline_s:
+                    return None
 
     def age_s(self) -> float:
         """Loop time since the last valid tip (inf before the first)."""

@@ -15,7 +15,6 @@ from matplotlib.figure import Figure
 from crest.paper.figure_output import new_figure, save_png
 
 
-
 def write_blind_report(result: dict, out_dir: Path | str) -> Path:
     """Write blind_benchmark.md and the figures into out_dir (created); returns the Markdown path."""
     out = Path(out_dir)

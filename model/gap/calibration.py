@@ -171,10 +171,10 @@ class _Objective:
 
 
 def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: CatheterParams | None = None,
-              zero_offsets_mm: Sequence[float] = (0.0, 0.0, 0.0, 0.0),
+              zero_offsets_mm: Sequence[float] = ZERO_OFFSETS_MM,
               effects: Mapping[str, Sequence[float]] | None = None, fit_base: bool = True,
-              resolution: Resolution = Resolution(), max_iterations: int = 30, restarts: int = MAX_RESTARTS,
-              executor: Executor | None = None) -> ModelFit:
+              resolution: Resolution = Resolution(), max_iterations: int = 30,
+              restarts: int = MAX_RESTARTS) -> ModelFit:
     """Fit the base parameters (unless fit_base is False) and the given effects' parameters.
 
     max_iterations bounds the cost evaluations of each least_squares run (not counting the
@@ -182,8 +182,6 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
     recordings: training recordings at full rate (decimated and capped here, Resolution.prepare_training).
     start: warm start; its geometry is replaced by the recordings'. prior: the catheter the
     physical ranges refer to (default: start). effects: {effect id: starting values}.
-    executor: evaluates the Jacobian's columns in parallel (forward differences as least_squares'
-    own '2-point' scheme); None evaluates them here.
     Returns a new ModelFit; `start` is unchanged.
     """
     prepared = resolution.prepare_training(recordings)
@@ -194,37 +192,18 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
     zero_start = np.asarray(zero_offsets_mm, dtype=float)
     objective = _Objective(layout, start, zero_start, prepared, resolution,
                            iteration_limit(ModelFit(start, tuple(zero_start), effects), prepared, resolution))
-    runs = 0
-    costs: list[float] = []
-    last: list[tuple[bytes, np.ndarray]] = []
-
-    def count(out: np.ndarray) -> None:
-        nonlocal runs
-        runs += 1
-        costs.append(0.5 * float(out @ out))
+    costs: list[float] = []   # 0.5 |r|^2 of every model run, the Jacobian's included
 
     def residuals(z: np.ndarray) -> np.ndarray:
         out = objective(z)
-        count(out)
-        last[:] = [(z.tobytes(), out)]
+        costs.append(0.5 * float(out @ out))
         return out
-
-    def parallel_jacobian(z: np.ndarray) -> np.ndarray:
-        f0 = last[0][1] if last and last[0][0] == z.tobytes() else residuals(z)
-        steps = DIFF_STEP * np.where(z >= 0, 1.0, -1.0) * np.maximum(1.0, np.abs(z))
-        steps = np.where(z + steps > high, -steps, steps)
-        points = [z + step * np.eye(len(z))[j] for j, step in enumerate(steps)]
-        columns = list(executor.map(objective, points))
-        for out in columns:
-            count(out)
-        return np.column_stack([(out - f0) / step for out, step in zip(columns, steps)])
 
     z = layout.pack(start, zero_start, effects)
     low, high = layout.bounds()
-    jac = "2-point" if executor is None else parallel_jacobian
     for _ in range(1 + restarts):
-        first_run = runs
-        result = least_squares(residuals, z, jac=jac, bounds=(low, high), method="trf", diff_step=DIFF_STEP,
+        first_run = len(costs)
+        result = least_squares(residuals, z, jac="2-point", bounds=(low, high), method="trf", diff_step=DIFF_STEP,
                                ftol=TOLERANCE, xtol=TOLERANCE, gtol=1e-8, max_nfev=max_iterations)
         improved = result.cost < (1.0 - RESTART_GAIN) * costs[first_run]
         z = result.x
@@ -239,7 +218,7 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
     return ModelFit(params=params, zero_offsets_mm=tuple(float(v) for v in zero), effects=values,
                     names=layout.names, values=tuple(float(v) for v in physical), std=tuple(float(s) for s in std),
                     correlation=tuple(tuple(float(c) for c in row) for row in correlation), flags=flags,
-                    train_rmse_mm=train_rmse, model_runs=runs)
+                    train_rmse_mm=train_rmse, model_runs=len(costs))
 
 
 def probe_costs(fits: Sequence[ModelFit], recordings: Sequence[Recording], resolution: Resolution) -> list[float]:
@@ -256,12 +235,12 @@ def iteration_limit(fit: ModelFit, recordings: Sequence[Recording], resolution: 
 
 
 def explore(recordings: Sequence[Recording], starts: Sequence[ModelFit], prior: CatheterParams,
-            resolution: Resolution, executor: Executor | None = None) -> list[ModelFit]:
+            resolution: Resolution) -> list[ModelFit]:
     """The short fit (EXPLORE_ITERATIONS cost evaluations, no restarts) of each start, base parameters
     and effects, lowest training RMSE first."""
     explored = [calibrate(recordings, start.params, prior=prior, zero_offsets_mm=start.zero_offsets_mm,
-                          effects=start.effects, resolution=resolution, max_iterations=EXPLORE_ITERATIONS, restarts=0,
-                          executor=executor) for start in starts]
+                          effects=start.effects, resolution=resolution, max_iterations=EXPLORE_ITERATIONS, restarts=0)
+                for start in starts]
     return sorted(explored, key=lambda fit: fit.train_rmse_mm)
 
 

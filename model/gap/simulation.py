@@ -98,7 +98,7 @@ def catheter_for(base: CatheterParams, recordings: Sequence[Recording]) -> Cathe
 
 
 class SimulationTooSlow(RuntimeError):
-    """A run exceeded its time limit: parameters where the quasi-static solver struggles."""
+    """A run exceeded its iteration limit: parameters where the quasi-static solver struggles."""
 
 
 def predict_tips(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray, recording: Recording,
@@ -110,29 +110,30 @@ def predict_tips(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: 
     does not either) the path runs in chunks of CHUNK_SAMPLES and SimulationTooSlow is raised
     once the limit is exceeded (fits use it to give up on parameters that make the solver crawl).
     """
+    return _run(params, effects, zero_offsets_mm, recording, resolution, iteration_limit)[0]
+
+
+def solver_work(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray,
+                recordings: Sequence[Recording], resolution: Resolution) -> int:
+    """Newton iterations of the model's runs along the recordings (the unit of `predict_tips`' limit)."""
+    return sum(_run(params, effects, zero_offsets_mm, r, resolution)[1] for r in recordings)
+
+
+def _run(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray, recording: Recording,
+         resolution: Resolution, iteration_limit: int | None = None) -> tuple[np.ndarray, int]:
+    """Tips [T, 3] and the Newton iterations they took (see `predict_tips`)."""
     model = _model(params, effects, recording, resolution)
     u = recording.tendon_mm - zero_offsets_mm
     dt_s = recording.sample_period_s
     if iteration_limit is None:
-        return model.run(u, recording.insertion_mm, dt_s)
+        return model.run(u, recording.insertion_mm, dt_s), model.solver_iterations[0]
     tips = np.empty((len(recording), 3))
     for start in range(0, len(recording), CHUNK_SAMPLES):
         stop = start + CHUNK_SAMPLES
         tips[start:stop] = model.run(u[start:stop], recording.insertion_mm[start:stop], dt_s)
         if model.solver_iterations[0] > iteration_limit:
             raise SimulationTooSlow(f"{recording.name}: the model run exceeded {iteration_limit} solver iterations")
-    return tips
-
-
-def solver_work(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray,
-                recordings: Sequence[Recording], resolution: Resolution) -> int:
-    """Newton iterations of the model's runs along the recordings (the unit of `predict_tips`' limit)."""
-    total = 0
-    for recording in recordings:
-        model = _model(params, effects, recording, resolution)
-        model.run(recording.tendon_mm - zero_offsets_mm, recording.insertion_mm, recording.sample_period_s)
-        total += model.solver_iterations[0]
-    return total
+    return tips, model.solver_iterations[0]
 
 
 def predict_tips_and_tension(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray,
