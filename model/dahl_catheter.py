@@ -7,6 +7,7 @@ parameters, the state, input validation and the public API.
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,6 +27,10 @@ class ModelInputError(ValueError):
 
 class ModelSolverError(ArithmeticError):
     """The equilibrium solve produced a non-finite state (parameters far outside their range)."""
+
+
+class SolverBudgetExceeded(ModelSolverError):
+    """A run needed more Newton iterations than its budget (parameters where the solver crawls)."""
 
 
 @dataclass
@@ -165,10 +170,13 @@ class DahlCatheter:
                                              np.asarray([insertion_mm], dtype=float).reshape(-1))
         return self._run(tendons, insertion, np.inf)[0]
 
-    def run(self, tendons_mm, insertion_mm=None, dt_s: float = 0.01) -> np.ndarray:
+    def run(self, tendons_mm, insertion_mm=None, dt_s: float = 0.01,
+            max_solver_iterations: float = math.inf) -> np.ndarray:
         """Drive along a sampled input path tendons_mm[T, 4], insertion_mm[T]; tips [T, 3] in mm.
 
         dt_s is the sample period; it matters only for rate-dependent effects.
+        max_solver_iterations: SolverBudgetExceeded (state unchanged) as soon as the run has taken
+        more Newton iterations; a measure of work that, unlike time, does not depend on the machine.
         """
         tendons = np.asarray(tendons_mm, dtype=float)
         if insertion_mm is None:
@@ -176,17 +184,22 @@ class DahlCatheter:
         tendons, insertion = self._validated(tendons, np.asarray(insertion_mm, dtype=float))
         if not (dt_s > 0):
             raise ModelInputError(f"dt_s must be > 0, got {dt_s!r}")
-        return self._run(tendons, insertion, float(dt_s))
+        return self._run(tendons, insertion, float(dt_s), float(max_solver_iterations))
 
-    def _run(self, tendons: np.ndarray, insertion: np.ndarray, dt_s: float) -> np.ndarray:
+    def _run(self, tendons: np.ndarray, insertion: np.ndarray, dt_s: float,
+             max_solver_iterations: float = math.inf) -> np.ndarray:
         before = self.state.copy()
         s = self.state
         tips = np.empty((len(tendons), 3))
-        run_path(tendons, insertion, dt_s, self.max_tendon_step_mm, self.max_insertion_step_mm,
-                 self.max_newton_iterations, self._kernel_params, self._kernel_effects, self._point_loads,
-                 s.applied_tendon_mm, s.applied_insertion_mm,
-                 s.friction_n, s.sliding_mm, s.last_step_mm, s.tension_n, s.bend_rad, s.compression_mm,
-                 s.tip_tension_n, s.drive_tension_n, s.slack, s.points_mm, s.frames, s.diagnostics, tips)
+        done = run_path(tendons, insertion, dt_s, self.max_tendon_step_mm, self.max_insertion_step_mm,
+                        self.max_newton_iterations, max_solver_iterations, self._kernel_params,
+                        self._kernel_effects, self._point_loads, s.applied_tendon_mm, s.applied_insertion_mm,
+                        s.friction_n, s.sliding_mm, s.last_step_mm, s.tension_n, s.bend_rad, s.compression_mm,
+                        s.tip_tension_n, s.drive_tension_n, s.slack, s.points_mm, s.frames, s.diagnostics, tips)
+        if done < len(tendons):
+            self.state = before
+            raise SolverBudgetExceeded(f"the model run stopped at sample {done} of {len(tendons)}: over its budget "
+                                       f"of {max_solver_iterations:g} solver iterations; the state is unchanged")
         if not (np.isfinite(tips).all() and np.isfinite(s.friction_n).all()):
             self.state = before
             raise ModelSolverError(f"the catheter model diverged (non-finite state) with {self.params}; "

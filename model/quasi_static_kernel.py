@@ -601,10 +601,16 @@ def remap_to_length(old_length, new_length, friction, sliding, last_step, tensio
 
 
 @kernel
-def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_step_mm, max_iterations, params, effects,
-             point_loads, applied_tendon_mm, applied_insertion_mm, friction, sliding, last_step, tension, bend,
-             compression, tip_tension, drive_tension, slack, points, frames, scalars, tips_out):
+def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_step_mm, max_iterations,
+             iteration_budget, params, effects, point_loads, applied_tendon_mm, applied_insertion_mm, friction,
+             sliding, last_step, tension, bend, compression, tip_tension, drive_tension, slack, points, frames,
+             scalars, tips_out):
     """Drive the model along a sampled input path; tips_out[t] is the tip after sample t.
+
+    Returns the number of samples done: all of them, unless the Newton iterations of this call
+    exceed iteration_budget (inf: no budget), where it stops at once (mid-sample, the state then
+    describes no sample; the caller restores it). Where the solver crawls, halving sub-steps
+    down to 1/2^MAX_HALVINGS, one sample can take 10^5 iterations.
 
     Inputs pass the drive-train plays first (backlash per tendon, tube play on insertion).
     point_loads (K, 4): external point forces (fx, fy, fz [N], distance from the tip [mm]).
@@ -624,6 +630,7 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
     rate_scale = np.ones(4)
     rate_per_mm = effects[E_RATE] / dt_s if (dt_s > 0.0 and math.isfinite(dt_s)) else 0.0
     work = make_workspace(bend.shape[0])
+    stop_at_iterations = scalars[S_ITERATIONS] + iteration_budget
     for t in range(n_samples):
         for k in range(4):
             target[k] = play_operator(applied_tendon_mm[k], tendon_mm[t, k], effects[E_BACKLASH])
@@ -657,9 +664,12 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
                 fraction = min(2.0 * fraction, 1.0 / n_sub)
             else:
                 fraction *= 0.5
+            if scalars[S_ITERATIONS] > stop_at_iterations:
+                return t
         for k in range(4):
             applied_tendon_mm[k] = target[k]
         applied_insertion_mm[0] = length_target
         nb = points.shape[0] - 1
         for a in range(3):
             tips_out[t, a] = points[nb, a]
+    return n_samples

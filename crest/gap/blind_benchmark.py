@@ -25,6 +25,7 @@ import math
 import tempfile
 import time
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -55,6 +56,9 @@ NO_RESULT = "no result"
 MIN_TIP_FRACTION_BEYOND_DROPOUT = 0.9
 RECORD_TIMEOUT_S = 900.0      # recording both logs normally takes 1-2 min
 DIAGNOSIS_TIMEOUT_S = 900.0   # a diagnosis normally takes 15-40 s
+# A recording keeps one core busy, a diagnosis two: two cases at once keep a 2-core machine busy.
+# The verdicts do not depend on it (the diagnosis limits solver iterations, not time).
+PARALLEL_CASES = 2
 
 
 class PlantFailure(RuntimeError):
@@ -289,10 +293,11 @@ def score(all_rows: list[dict]) -> dict:
 
 def run_blind_benchmark(cases: int = 40, seed: int = 0, *, short: bool = False,
                         settings: DiagnosisSettings = DiagnosisSettings(), work_dir: Path | str | None = None,
-                        progress: Callable[[str], None] | None = None) -> dict:
+                        parallel_cases: int = PARALLEL_CASES, progress: Callable[[str], None] | None = None) -> dict:
     """Draw, record, diagnose and score `cases` blind cases; returns {"score", "cases", "settings"}.
 
     work_dir keeps each case's plant description and logs (default: a temporary folder).
+    parallel_cases: cases run at once (each records and diagnoses in processes of its own).
     """
     say = progress or (lambda message: None)
     prior = CatheterParams.from_toml()
@@ -302,20 +307,24 @@ def run_blind_benchmark(cases: int = 40, seed: int = 0, *, short: bool = False,
     clock = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="crest-blind-") as scratch:
         root = Path(work_dir) if work_dir else Path(scratch)
-        for case in draw_cases(cases, seed, prior):
-            rows.append(run_case(case, root / f"case_{case.index:03d}", config, plan, prior, settings))
-            row = rows[-1]
-            elapsed = time.perf_counter() - clock
-            eta = elapsed / len(rows) * (cases - len(rows))
-            head = f"blind case {case.index + 1}/{cases} ({elapsed / 60:.0f} min, about {eta / 60:.0f} min left)"
-            (root / "cases.json").write_text(json.dumps(rows, indent=1))    # kept should the run be cut short
-            if "skipped" in row or "no_result" in row:
-                say(f"{head}: truth {'+'.join(row['truth']) or 'none'}, {row.get('skipped') or row['no_result']}")
-                continue
-            say(f"{head}: truth {'+'.join(row['truth']) or 'none'}, verdict "
-                f"{'+'.join(row['predicted_effects']) or 'none'}, shrink {row['predicted_shrink']:.2f} "
-                f"(oracle {row['oracle_shrink']:.2f}), recorded in {row['record_seconds']:.0f} s, "
-                f"diagnosed in {row['seconds']:.0f} s")
+
+        def run(case: BlindCase) -> dict:
+            return run_case(case, root / f"case_{case.index:03d}", config, plan, prior, settings)
+
+        with ThreadPoolExecutor(parallel_cases) as pool:
+            for row in pool.map(run, draw_cases(cases, seed, prior)):
+                rows.append(row)
+                elapsed = time.perf_counter() - clock
+                eta = elapsed / len(rows) * (cases - len(rows))
+                head = f"blind case {row['case'] + 1}/{cases} ({elapsed / 60:.0f} min, about {eta / 60:.0f} min left)"
+                (root / "cases.json").write_text(json.dumps(rows, indent=1))    # kept should the run be cut short
+                if "skipped" in row or "no_result" in row:
+                    say(f"{head}: truth {'+'.join(row['truth']) or 'none'}, {row.get('skipped') or row['no_result']}")
+                    continue
+                say(f"{head}: truth {'+'.join(row['truth']) or 'none'}, verdict "
+                    f"{'+'.join(row['predicted_effects']) or 'none'}, shrink {row['predicted_shrink']:.2f} "
+                    f"(oracle {row['oracle_shrink']:.2f}), recorded in {row['record_seconds']:.0f} s, "
+                    f"diagnosed in {row['seconds']:.0f} s")
     total = time.perf_counter() - clock
     return {"score": score(rows), "cases": rows,
             "settings": {"cases": cases, "seed": seed, "excitation": "short" if short else "standard",

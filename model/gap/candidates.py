@@ -143,7 +143,8 @@ def run_task(task: FitTask) -> CandidateResult:
                             (catheter_for(task.prior, train), (0.0, 0.0, 0.0, 0.0))):
             probed = [with_last(base, zeros, probe) for probe in probes]
             candidates.append(probed[int(np.argmin(probe_costs(probed, train, task.resolution)))])
-        start = explore(task.train, candidates, task.prior, task.resolution)[0]
+        unique = [c for i, c in enumerate(candidates) if c not in candidates[:i]]   # a probe may pick 'off'
+        start = explore(task.train, unique, task.prior, task.resolution)[0]
     elif task.mode == PROBE:
         probed = [with_last(start.params, start.zero_offsets_mm, probe) for probe in probes]
         start = probed[int(np.argmin(probe_costs(probed, train, task.resolution)))]

@@ -6,6 +6,7 @@ straight, unloaded state at its first free length.
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -17,7 +18,6 @@ from model.gap.recording import Recording, RecordingError
 from model.params import CatheterParams
 
 TENDON_RANGE_MARGIN_MM = 10.0
-CHUNK_SAMPLES = 50
 
 
 @dataclass(frozen=True)
@@ -97,18 +97,14 @@ def catheter_for(base: CatheterParams, recordings: Sequence[Recording]) -> Cathe
                         tendon_range_mm=(-reach, reach))
 
 
-class SimulationTooSlow(RuntimeError):
-    """A run exceeded its iteration limit: parameters where the quasi-static solver struggles."""
-
-
 def predict_tips(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray, recording: Recording,
                  resolution: Resolution, iteration_limit: int | None = None) -> np.ndarray:
     """Model tips [T, 3] (mm) along the recording's measured inputs, from the straight state.
 
     With an iteration limit (Newton iterations of the quasi-static solver: a measure of the work
     that, unlike a time, does not depend on the machine or what else it runs, so a fit's result
-    does not either) the path runs in chunks of CHUNK_SAMPLES and SimulationTooSlow is raised
-    once the limit is exceeded (fits use it to give up on parameters that make the solver crawl).
+    does not either) the run stops as soon as it exceeds the limit, with SolverBudgetExceeded
+    (fits use it to give up on parameters that make the solver crawl).
     """
     return _run(params, effects, zero_offsets_mm, recording, resolution, iteration_limit)[0]
 
@@ -123,16 +119,8 @@ def _run(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarr
          resolution: Resolution, iteration_limit: int | None = None) -> tuple[np.ndarray, int]:
     """Tips [T, 3] and the Newton iterations they took (see `predict_tips`)."""
     model = _model(params, effects, recording, resolution)
-    u = recording.tendon_mm - zero_offsets_mm
-    dt_s = recording.sample_period_s
-    if iteration_limit is None:
-        return model.run(u, recording.insertion_mm, dt_s), model.solver_iterations[0]
-    tips = np.empty((len(recording), 3))
-    for start in range(0, len(recording), CHUNK_SAMPLES):
-        stop = start + CHUNK_SAMPLES
-        tips[start:stop] = model.run(u[start:stop], recording.insertion_mm[start:stop], dt_s)
-        if model.solver_iterations[0] > iteration_limit:
-            raise SimulationTooSlow(f"{recording.name}: the model run exceeded {iteration_limit} solver iterations")
+    tips = model.run(recording.tendon_mm - zero_offsets_mm, recording.insertion_mm, recording.sample_period_s,
+                     math.inf if iteration_limit is None else iteration_limit)
     return tips, model.solver_iterations[0]
 
 

@@ -4,7 +4,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from model import CatheterParams, DahlCatheter, ModelInputError, ParamsError
+from model import CatheterParams, DahlCatheter, ModelInputError, ParamsError, SolverBudgetExceeded
 from tests.model.conftest import articulation
 
 
@@ -26,6 +26,22 @@ def test_bad_command_raises_and_keeps_state(params, tendons, insertion, match):
     before = model.snapshot()
     with pytest.raises(ModelInputError, match=match):
         model.move_to(tendons, insertion)
+    assert_same_state(before, model.state)
+
+
+def test_a_run_over_its_iteration_budget_stops_at_once_and_keeps_state(params):
+    model = DahlCatheter(params)
+    model.move_to(articulation(params, 30.0))
+    before = model.snapshot()
+    ramp_mm = np.linspace(0.0, 4.0, 200)
+    path = np.column_stack([ramp_mm, np.zeros(200), -ramp_mm, np.zeros(200)])
+    needed = DahlCatheter(params)
+    needed.move_to(articulation(params, 30.0))
+    start_iterations = needed.solver_iterations[0]
+    needed.run(path)
+    assert needed.solver_iterations[0] - start_iterations > 100
+    with pytest.raises(SolverBudgetExceeded, match=r"stopped at sample \d of 200"):
+        model.run(path, max_solver_iterations=5)
     assert_same_state(before, model.state)
 
 
