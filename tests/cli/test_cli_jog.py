@@ -8,6 +8,8 @@ import time
 from cli_runner import CREST, REPO
 from crest.log import read_log
 
+STARTUP_TIMEOUT_S = 300.0
+
 
 def read_until(fd, needle: bytes, timeout_s: float) -> bytes:
     out = b""
@@ -29,7 +31,9 @@ def test_jog_moves_pitch_and_insertion_and_releases_on_quit(tmp_path):
                                stdin=slave, stdout=slave, stderr=slave, close_fds=True)
     os.close(slave)
     try:
-        read_until(master, b"L  20.0 mm", timeout_s=60)     # homed at 20 mm free length; status line is up
+        # homed at 20 mm free length; status line is up. The first run in a fresh environment compiles
+        # the model kernel (numba), which on a busy 2-core machine took over 60 s.
+        read_until(master, b"L  20.0 mm", timeout_s=STARTUP_TIMEOUT_S)
         os.write(master, b"sss")                              # pitch +6 deg
         read_until(master, b"pitch   +6.0 deg", timeout_s=30)
         os.write(master, b"rr")                               # 2 mm more free length
