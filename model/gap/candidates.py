@@ -30,8 +30,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from model.effects.catalog import effect
-from model.gap.calibration import (MIN_ITERATION_LIMIT, ModelFit, calibrate, explore, iteration_limit,
-                                   probe_costs, rmse_mm, tip_errors)
+from model.gap.calibration import (MIN_ITERATION_LIMIT, ZERO_OFFSETS_MM, ModelFit, calibrate, explore,
+                                   iteration_limit, probe_costs, rmse_mm, tip_errors)
 from model.gap.recording import Recording
 from model.gap.simulation import Resolution, catheter_for
 from model.gap.starting_points import probe_values, start_values
@@ -139,8 +139,8 @@ def run_task(task: FitTask) -> CandidateResult:
     start = task.start
     if task.mode == EXPLORE:
         candidates = [with_last(start.params, start.zero_offsets_mm, start_values(last) if last else ())]
-        for base, zeros in ((start.params, start.zero_offsets_mm), (start.params, (0.0, 0.0, 0.0, 0.0)),
-                            (catheter_for(task.prior, train), (0.0, 0.0, 0.0, 0.0))):
+        for base, zeros in ((start.params, start.zero_offsets_mm), (start.params, ZERO_OFFSETS_MM),
+                            (catheter_for(task.prior, train), ZERO_OFFSETS_MM)):
             probed = [with_last(base, zeros, probe) for probe in probes]
             candidates.append(probed[int(np.argmin(probe_costs(probed, train, task.resolution)))])
         unique = [c for i, c in enumerate(candidates) if c not in candidates[:i]]   # a probe may pick 'off'

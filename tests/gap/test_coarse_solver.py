@@ -17,9 +17,10 @@ from model.gap.simulation import Resolution, predict_tips
 
 PATH = Path(__file__).parent / "data" / "held_out_circles_path.csv"
 SAMPLE_PERIOD_S = 0.09
-FITTED = CatheterParams.from_toml().replace(bending_stiffness_nmm2=695.359054507092, axial_stiffness_n=119664.23580001431,
-                                            mu=0.17295525756757046, fsc_n_per_mm=0.007327412904718217,
-                                            sigma_n_per_mm2=1.9000443337389636, tendon_range_mm=(-14.4, 14.4))
+FITTED = CatheterParams.from_toml().replace(bending_stiffness_nmm2=695.359054507092,
+                                            axial_stiffness_n=119664.23580001431, mu=0.17295525756757046,
+                                            fsc_n_per_mm=0.007327412904718217, sigma_n_per_mm2=1.9000443337389636,
+                                            tendon_range_mm=(-14.4, 14.4))
 
 
 def circles(samples: int | None = None) -> Recording:
