@@ -30,6 +30,8 @@ def run_with_controller(session: Session, setpoints: Iterable[SetPoint], control
                         recorder: ExperimentRecorder | None = None, closed_loop: bool = False,
                         on_cycle: Callable[[int], None] | None = None) -> RunResult:
     testbed = session.testbed
+    if closed_loop and session.tracker is None:
+        raise ValueError("a closed-loop run needs the tip tracker, and this session has none; nothing was moved")
     feed = session.tip_feed()
     if closed_loop:
         testbed.watch_tracker(feed.age_s)

@@ -3,7 +3,9 @@
 The tracker driver stamps samples with the host's monotonic clock; the loop may run on
 simulated time. A sample is taken as new when its frame number changes, and is stamped with
 the loop time at which it was first seen, so both clocks agree (tracker latency is below one
-cycle of the 40 Hz tracker). `age_s` is the loop time since the last valid tip.
+cycle of the 40 Hz tracker). `age_s` is the loop time since the last valid tip, or, before the
+first one, since the first poll: a run whose first frames report the tool MISSING (dropout) has
+the same loss_timeout_s of grace as one that loses the tool later.
 
 In simulated time (`sample_period_s` given) the loop runs faster than the wall-clock tracker, so
 the feed asks for a fresh frame once per tracker period of simulated time and waits for it:
@@ -39,12 +41,15 @@ class TipFeed:
         self._next_sample_s = 0.0
         self._frame: int | None = None
         self._last_valid_s: float | None = None
+        self._first_poll_s: float | None = None
         self._now_s = 0.0
         self.latest_tip_mm: np.ndarray | None = None
 
     def poll(self, now_s: float) -> TipMeasurement | None:
         """The newest tip as a measurement, or None (no tracker, no new frame, or tool missing)."""
         self._now_s = now_s
+        if self._first_poll_s is None:
+            self._first_poll_s = now_s
         if self.tracker is None:
             return None
         if self.sample_period_s is None:
@@ -77,5 +82,6 @@ class TipFeed:
                     return None
 
     def age_s(self) -> float:
-        """Loop time since the last valid tip (inf before the first)."""
-        return math.inf if self._last_valid_s is None else self._now_s - self._last_valid_s
+        """Loop time since the last valid tip, or since the first poll before any (inf before that)."""
+        since_s = self._first_poll_s if self._last_valid_s is None else self._last_valid_s
+        return math.inf if since_s is None else self._now_s - since_s

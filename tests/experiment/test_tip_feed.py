@@ -39,8 +39,9 @@ def test_a_frame_late_in_wall_time_still_arrives_while_the_link_is_up():
 def test_a_lost_link_gives_no_sample_at_once_and_the_age_grows_in_loop_time():
     tracker = LateTracker(late_waits=0, state=TrackerState.RECONNECTING)
     feed = TipFeed(tracker, sample_period_s=PERIOD_S)
+    assert feed.age_s() == float("inf")                 # not polled yet
     assert feed.poll(0.0) is None and tracker.timeouts == 1
-    assert feed.age_s() == float("inf")
+    assert feed.age_s() == 0.0                          # no tip yet: the age counts from the first poll
     tracker.state = TrackerState.TRACKING
     assert feed.poll(PERIOD_S) is not None
     tracker.state = TrackerState.RECONNECTING
