@@ -40,16 +40,15 @@ class TipFeed:
         self.sample_period_s = sample_period_s
         self._next_sample_s = 0.0
         self._frame: int | None = None
-        self._last_valid_s: float | None = None
-        self._first_poll_s: float | None = None
+        self._silent_since_s: float | None = None    # the last valid tip's time, or the first poll's before any
         self._now_s = 0.0
         self.latest_tip_mm: np.ndarray | None = None
 
     def poll(self, now_s: float) -> TipMeasurement | None:
         """The newest tip as a measurement, or None (no tracker, no new frame, or tool missing)."""
         self._now_s = now_s
-        if self._first_poll_s is None:
-            self._first_poll_s = now_s
+        if self._silent_since_s is None:
+            self._silent_since_s = now_s
         if self.tracker is None:
             return None
         if self.sample_period_s is None:
@@ -68,7 +67,7 @@ class TipFeed:
             self.latest_tip_mm = None
             return None
         self.latest_tip_mm = np.asarray(sample.tip_mm, dtype=float)
-        self._last_valid_s = now_s
+        self._silent_since_s = now_s
         return TipMeasurement(self.latest_tip_mm, now_s)
 
     def _wait_next(self) -> TipSample | None:
@@ -83,5 +82,4 @@ class TipFeed:
 
     def age_s(self) -> float:
         """Loop time since the last valid tip, or since the first poll before any (inf before that)."""
-        since_s = self._first_poll_s if self._last_valid_s is None else self._last_valid_s
-        return math.inf if since_s is None else self._now_s - since_s
+        return math.inf if self._silent_since_s is None else self._now_s - self._silent_since_s
