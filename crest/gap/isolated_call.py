@@ -1,9 +1,12 @@
-"""Run a function in a forked process of its own session, with a time limit.
+"""Run a function in a forked process of its own process group, with a time limit.
 
 The model's compiled solver holds the interpreter while it runs, so a solve that never returns
 (see the blind benchmark) cannot be interrupted from inside the process. Run in a child that
 leads its own process group, it is ended from outside: on time-out the whole group (the child
 and any workers it started) is killed, and nothing else.
+
+Both the parent and the child put the child into its own group (as a shell does), so the group
+exists from the moment ``start`` returns, however late the child is first scheduled.
 """
 from __future__ import annotations
 
@@ -20,18 +23,22 @@ class CallTimedOut(RuntimeError):
 def call_isolated(function: Callable, *args, timeout_s: float, **kwargs):
     """function(*args, **kwargs) in a forked child; its result, or its exception re-raised here.
 
-    Raises CallTimedOut after timeout_s seconds without a result.
+    Raises CallTimedOut after timeout_s seconds without a result. On that, or on anything else
+    that ends the wait here (Ctrl-C), the child's process group is killed before this returns.
     """
     context = multiprocessing.get_context("fork")
     receiver, sender = context.Pipe(duplex=False)
-    child = context.Process(target=_run_in_own_session, args=(sender, function, args, kwargs))
+    child = context.Process(target=_run_in_own_group, args=(sender, function, args, kwargs))
     child.start()
+    _lead_own_group(child.pid)
     sender.close()
     try:
         if not receiver.poll(timeout_s):
-            os.killpg(child.pid, signal.SIGKILL)
             raise CallTimedOut(f"{function.__name__} did not return within {timeout_s:.0f} s")
         failed, value = receiver.recv()
+    except BaseException:
+        _kill_group(child.pid)
+        raise
     finally:
         child.join()
         receiver.close()
@@ -40,8 +47,24 @@ def call_isolated(function: Callable, *args, timeout_s: float, **kwargs):
     return value
 
 
-def _run_in_own_session(sender, function: Callable, args: tuple, kwargs: dict) -> None:
-    os.setsid()
+def _lead_own_group(pid: int) -> None:
+    """setpgid(pid, pid); a child that has already ended needs no group."""
+    try:
+        os.setpgid(pid, pid)
+    except ProcessLookupError:
+        pass
+
+
+def _kill_group(pid: int) -> None:
+    """SIGKILL to every process of the group; a group whose processes have all ended is left."""
+    try:
+        os.killpg(pid, signal.SIGKILL)
+    except ProcessLookupError:
+        pass
+
+
+def _run_in_own_group(sender, function: Callable, args: tuple, kwargs: dict) -> None:
+    _lead_own_group(0)
     try:
         sender.send((False, function(*args, **kwargs)))
     except Exception as error:  # any failure of the call is handed to the caller, who decides

@@ -1,6 +1,7 @@
 """Isolated calls (blind benchmark): a result comes back, an exception comes back, and a call that does not
-return in time is ended with its whole process group."""
+return in time, or is interrupted by Ctrl-C, is ended with its whole process group."""
 import os
+import signal
 import time
 
 import pytest
@@ -29,6 +30,26 @@ def test_a_call_that_does_not_return_is_killed(tmp_path):
     with pytest.raises(CallTimedOut):
         call_isolated(child_pid_then_sleep, tmp_path / "pid", 60.0, timeout_s=1.0)
     assert time.monotonic() - start < 10.0
-    pid = int((tmp_path / "pid").read_text())
+    assert_ended(tmp_path / "pid")
+
+
+def assert_ended(pid_path):
+    pid = int(pid_path.read_text())
     with pytest.raises(ProcessLookupError):
         os.kill(pid, 0)
+
+
+def test_ctrl_c_while_waiting_kills_the_call(tmp_path):
+    def ctrl_c(signum, frame):
+        raise KeyboardInterrupt
+    previous = signal.signal(signal.SIGALRM, ctrl_c)
+    signal.setitimer(signal.ITIMER_REAL, 2.0)
+    start = time.monotonic()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            call_isolated(child_pid_then_sleep, tmp_path / "pid", 60.0, timeout_s=60.0)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+        signal.signal(signal.SIGALRM, previous)
+    assert time.monotonic() - start < 10.0
+    assert_ended(tmp_path / "pid")
