@@ -6,7 +6,7 @@ leads its own process group, it is ended from outside: on time-out the whole gro
 and any workers it started) is killed, and nothing else.
 
 Both the parent and the child put the child into its own group (as a shell does), so the group
-exists from the moment ``start`` returns, however late the child is first scheduled.
+exists before the parent starts waiting, however late the child is first scheduled.
 """
 from __future__ import annotations
 

@@ -19,6 +19,13 @@ def fail(message):
     raise ValueError(message)
 
 
+def assert_ended(pid_path):
+    """The process whose pid the child wrote no longer exists."""
+    pid = int(pid_path.read_text())
+    with pytest.raises(ProcessLookupError):
+        os.kill(pid, 0)
+
+
 def test_result_and_exception_come_back():
     assert call_isolated(pow, 2, 10, timeout_s=30.0) == 1024
     with pytest.raises(ValueError, match="bad input"):
@@ -31,12 +38,6 @@ def test_a_call_that_does_not_return_is_killed(tmp_path):
         call_isolated(child_pid_then_sleep, tmp_path / "pid", 60.0, timeout_s=1.0)
     assert time.monotonic() - start < 10.0
     assert_ended(tmp_path / "pid")
-
-
-def assert_ended(pid_path):
-    pid = int(pid_path.read_text())
-    with pytest.raises(ProcessLookupError):
-        os.kill(pid, 0)
 
 
 def test_ctrl_c_while_waiting_kills_the_call(tmp_path):
