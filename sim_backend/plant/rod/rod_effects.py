@@ -58,12 +58,13 @@ ROD_EFFECTS: dict[str, RodEffect] = {e.id: e for e in (
               "Coulomb friction of the catheter in its support tube, driven through a compliant "
               "proximal shaft: the free length moves only once the shaft force exceeds the grip, "
               "a play of +-grip_friction_n / shaft_stiffness_n_per_mm",
-              {"grip_friction_n": _p(1.0, 0.3, 5.0, "log", (0.0, 50.0)),
+              {"grip_friction_n": _p(2.0, 0.3, 6.0, "log", (0.0, 50.0)),
                "shaft_stiffness_n_per_mm": _p(1.0, 0.5, 4.0, "log", (0.01, 1000.0))}),
     RodEffect("gravity",
-              "distributed self-weight load_n_per_mm across the insertion axis, pointing at "
-              "direction_deg in the base x-y plane (0 = +x, 270 = -y)",
-              {"load_n_per_mm": _p(4e-4, 1e-4, 1.5e-3, "log", (0.0, 0.02)),
+              "distributed self-weight load_n_per_mm (a fluid-filled shaft with its sensor cable, ~2x "
+              "the dry shaft's 4e-4) across the insertion axis, pointing at direction_deg in the base "
+              "x-y plane (0 = +x, 270 = -y); taut tendons carry much of it, so the sag is below a bare rod's",
+              {"load_n_per_mm": _p(8e-4, 2e-4, 2e-3, "log", (0.0, 0.02)),
                "direction_deg": _p(270.0, 0.0, 360.0, "uniform", (-360.0, 720.0))}),
     RodEffect("torsion",
               "helical lumen routing: each tendon's angle in the cross-section turns by "
@@ -87,8 +88,8 @@ ROD_EFFECTS: dict[str, RodEffect] = {e.id: e for e in (
     RodEffect("sheath_creep",
               "viscoelastic creep of the sheath: its rest curvature relaxes toward creep_fraction of "
               "the bend with time_constant_s, so a sustained bend slowly deepens (long-term EI*(1-f))",
-              {"creep_fraction": _p(0.1, 0.03, 0.3, "log", (0.0, 0.9)),
-               "time_constant_s": _p(10.0, 2.0, 60.0, "log", (0.01, 1e5))}, in_catalog=False),
+              {"creep_fraction": _p(0.15, 0.03, 0.3, "log", (0.0, 0.9)),
+               "time_constant_s": _p(5.0, 1.0, 60.0, "log", (0.01, 1e5))}, in_catalog=False),
     RodEffect("lumen_offset_drift",
               "the lumens' radius drifts linearly along the free length, by tip_offset_change_mm at "
               "the tip relative to the tube exit",

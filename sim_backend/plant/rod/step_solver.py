@@ -187,7 +187,7 @@ def solve_step(h_mm, ei_nmm2, r_mm, cos_phi, sin_phi, ea_axial_n, kappa_rest, ka
             trial_held = np.zeros(4, dtype=np.bool_)
             for k in range(4):
                 trial_held[k] = trial_drive[k] <= 0.0 and trial_residual[k] >= 0.0
-            if has_weight or _free_norm(trial_residual, trial_held) < norm:
+            if _free_norm(trial_residual, trial_held) < norm:
                 break
             scale *= 0.5
         drive_n[:] = trial_drive
