@@ -7,16 +7,16 @@ import sys
 from pathlib import Path
 
 from control.benchmark import controller_cycle_times
-from crest.bench import model_bench, stack_bench
+from crest.bench import model_bench, plant_bench, stack_bench
 from crest.bench.machine_info import machine_info
 from crest.gap.benchmark import diagnosis_time
 from model import CatheterParams
 
-SECTIONS = ("model", "scaling", "move", "controllers", "full_stack", "gap")
+SECTIONS = ("model", "scaling", "move", "controllers", "rod_plant", "full_stack", "gap")
 
 
 def add_parser(sub) -> None:
-    parser = sub.add_parser("bench", help="benchmark the model, controllers, full stack and gap diagnosis")
+    parser = sub.add_parser("bench", help="benchmark the model, controllers, rod plant, full stack and gap diagnosis")
     parser.add_argument("--json", dest="json_path", default="bench.json", help="where to write the results")
     parser.add_argument("--only", nargs="+", choices=SECTIONS, default=list(SECTIONS),
                         help="run only these sections")
@@ -33,6 +33,7 @@ def run(args: argparse.Namespace) -> int:
         "scaling": lambda: model_bench.scaling_in_n(params),
         "move": lambda: model_bench.quasi_static_move(params),
         "controllers": lambda: controller_cycle_times(params),
+        "rod_plant": lambda: plant_bench.rod_plant(),
         "full_stack": lambda: {f"{rate:.0f}_hz": stack_bench.full_stack(rate, args.stack_seconds)
                                for rate in (500.0, 250.0)},
         "gap": lambda: diagnosis_time(),
@@ -64,6 +65,11 @@ def format_table(results: dict) -> str:
     for name, r in results.get("controllers", {}).items():
         rows.append((f"Controller {name}, per cycle", f"median {r['median_us']:.0f} us, p99 {r['p99_us']:.0f} us",
                      "well inside 10 ms", r["p99_us"] < 5000))
+    for r in results.get("rod_plant", {}).values():
+        rows.append((f"Rod plant step, M={r['grid_nodes']} nodes", f"{r['step_rate_hz']:.0f} steps/s, "
+                     f"{r['real_time_factor_at_100_hz']:.1f}x real time at 100 Hz "
+                     f"({r['step_rate_per_cpu_s']:.0f} steps per CPU second)",
+                     f">= {r['goal_step_rate_hz']:.0f} steps/s", r["step_rate_hz"] >= r["goal_step_rate_hz"]))
     for key, r in results.get("full_stack", {}).items():
         rows.append((f"Full stack at {r['sync_rate_hz_nominal']:.0f} Hz SYNC, {r['duration_s']:.0f} s",
                      f"{r['achieved_rate_hz']:.0f} Hz, jitter p50 {r['jitter_p50_ms']:.2f} / p99 "
