@@ -12,7 +12,8 @@ Each step (quasi-static, step_solver.py does the rod and tendons):
    straight tube the tendons neither bend nor wrap). With `tube_friction` the free length follows
    the insertion axis only once the shaft force exceeds the grip: L moves to stay within
    +-F_grip / k_shaft of the axis.
-3. Solve for the drive tensions (Newton) with the friction return mapping from the last profile.
+3. Solve for the drive tensions (Newton) with the friction return mapping from the last profile;
+   a step that does not converge is retried in 4, 16, 64 increments of the pull.
 4. Creep (sheath_creep): the rest curvature relaxes toward f (kappa - kappa_set),
    kappa_c += (f (kappa - kappa_set) - kappa_c) (1 - exp(-dt / tau)).
 5. The tip: the last node, plus the sensor's mount offset turned by the tip frame (tracker_offset).
@@ -30,7 +31,10 @@ from sim_backend.plant.rod.step_solver import solve_step
 
 MIN_FREE_LENGTH_MM = 1.0
 TOLERANCE_MM = 1e-7        # compatibility residual of each tendon at the solution
-MAX_ITERATIONS = 60
+MAX_ITERATIONS = 100
+# a step that does not converge is retried from where the last converged increment left, the
+# rest of the pull moved in this many equal increments (a finer quasi-static path through the friction kinks)
+SUBSTEPS = (1, 4, 16, 64)
 
 
 class RodSolverError(RuntimeError):
@@ -90,27 +94,41 @@ class RodPlant:
         nodes = self._node_cache
         mu = self.description.mu * (1.0 + self._mu_rate * speed_mm_s)
         kappa_rest = nodes["kappa_set"] + self.creep_per_mm
-        tension = np.empty_like(self.tension_n)
-        drive = self.drive_tension_n.copy()
-        iterations = solve_step(nodes["h_mm"], nodes["ei"], nodes["r"], nodes["cos_phi"], nodes["sin_phi"], nodes["ea_axial"],
-                                kappa_rest,
-                                nodes["kappa_set"], nodes["weight"], self._drive_compliance,
-                                self.description.tendon_axial_stiffness_n, mu, self.description.friction_n_per_mm,
-                                pull, self.tension_n, drive, tension, self.kappa_per_mm, self.rotation,
-                                self.position_mm, TOLERANCE_MM, MAX_ITERATIONS)
-        if iterations < 0:
+        start_mm = self.pull_mm
+        for substeps in SUBSTEPS:
+            if self._follow(self.pull_mm, pull, substeps, nodes, mu, kappa_rest):
+                break
+        else:
             raise RodSolverError(f"rod plant: no tendon-tension solution within {MAX_ITERATIONS} Newton iterations "
-                                 f"at pull {np.round(pull, 4)} mm, free length {self.free_length_mm:.2f} mm")
-        self.iterations = iterations
-        self.tension_n = tension
-        self.drive_tension_n = drive
-        self.pull_mm = pull
+                                 f"from pull {np.round(start_mm, 4)} to {np.round(pull, 4)} mm even in "
+                                 f"{SUBSTEPS[-1]} sub-steps, free length {self.free_length_mm:.2f} mm")
         if self._creep_fraction > 0.0 and dt_s > 0.0:
             relax = 1.0 - math.exp(-dt_s / self._creep_tau_s)
             self.creep_per_mm += (self._creep_fraction * (self.kappa_per_mm - nodes["kappa_set"])
                                   - self.creep_per_mm) * relax
         tip = self.position_mm[-1] + self.rotation[-1] @ self._sensor_mm
-        return tip, drive.copy()
+        return tip, self.drive_tension_n.copy()
+
+    def _follow(self, start_mm, pull_mm, substeps: int, nodes: dict, mu, kappa_rest) -> bool:
+        """Move the pull from start_mm to pull_mm in `substeps` equal quasi-static increments,
+        each from the friction state the last one left; False (state at the last increment that
+        converged) if one does not converge."""
+        for j in range(1, substeps + 1):
+            target = start_mm + (pull_mm - start_mm) * (j / substeps)
+            tension = np.empty_like(self.tension_n)
+            drive = self.drive_tension_n.copy()
+            iterations = solve_step(nodes["h_mm"], nodes["ei"], nodes["r"], nodes["cos_phi"], nodes["sin_phi"],
+                                    nodes["ea_axial"], kappa_rest, nodes["kappa_set"], nodes["weight"],
+                                    self._drive_compliance, self.description.tendon_axial_stiffness_n, mu,
+                                    self.description.friction_n_per_mm, target, self.tension_n, drive, tension,
+                                    self.kappa_per_mm, self.rotation, self.position_mm, TOLERANCE_MM, MAX_ITERATIONS)
+            if iterations < 0:
+                return False
+            self.iterations = iterations
+            self.tension_n = tension
+            self.drive_tension_n = drive
+            self.pull_mm = target
+        return True
 
     # -- free length and the grid ---------------------------------------------------------------
     def _move_free_length(self, insertion_mm: float) -> None:

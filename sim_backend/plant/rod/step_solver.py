@@ -41,6 +41,8 @@ from numba import njit
 from sim_backend.plant.rod.backbone import segment_displacement, segment_rotation, weight_moments_body
 from sim_backend.plant.rod.tendon_friction import clamp_to_capstan
 
+BACKTRACKS = 8       # halvings of a Newton step before it is taken whole
+
 
 @njit(cache=True)
 def _curvature(i, tension, r_mm, cos_phi, sin_phi, ei_nmm2, kappa_rest, moment_w, out):
@@ -133,8 +135,8 @@ def solve_step(h_mm, ei_nmm2, r_mm, cos_phi, sin_phi, ea_axial_n, kappa_rest, ka
                tension, kappa, rotation, position, tol_mm, max_iterations):
     """Projected Newton on the drive tensions `drive_n` (in: the guess, out: the solution).
 
-    Each Newton step is backtracked (halved up to 12 times) until |g| decreases: the return
-    mapping makes g only piecewise smooth, with kinks where a slip zone ends.
+    Each Newton step is backtracked (halved up to BACKTRACKS times) until |g| decreases: the
+    return mapping makes g only piecewise smooth, with kinks where a slip zone ends.
     `rotation` and `position` come in with the latest shape (for the weight's moment) and go out
     with the solution's; `tension` and `kappa` go out with the solution's profiles. Returns the
     number of iterations, or -1 if max_iterations passed without |g| < tol_mm (and, with weight,
@@ -177,8 +179,12 @@ def solve_step(h_mm, ei_nmm2, r_mm, cos_phi, sin_phi, ea_axial_n, kappa_rest, ka
                 jacobian[k, k] = 1.0
                 residual[k] = 0.0
         step = np.linalg.solve(jacobian, -residual)
+        # backtrack while |g| does not decrease; if no fraction of the step decreases it (a
+        # kink: the slip zones change), take the whole step (non-monotone, leaves the kink)
         scale = 1.0
-        for attempt in range(13):
+        for attempt in range(BACKTRACKS + 1):
+            if attempt == BACKTRACKS:
+                scale = 1.0
             for k in range(4):
                 trial_drive[k] = max(drive_n[k] + scale * step[k], 0.0)
             _walk(trial_drive, h_mm, ei_nmm2, r_mm, cos_phi, sin_phi, ea_axial_n, kappa_rest, kappa_set, moment_w,
