@@ -107,3 +107,17 @@ def test_insertion_moves_the_tip_along_the_tube_axis():
     for length in (20.0, 55.0, 100.0):
         tip, _ = pull(plant, 0.0, length)
         assert np.allclose(tip, [0.0, 0.0, length], atol=1e-9)
+
+
+def test_a_sudden_jump_with_rate_friction_on_a_moving_free_length_is_solved():
+    # Once stalled the Newton solver (a step whose every fraction raised |g| at a friction kink):
+    # a circle whose yaw tendons jump by 3 mm in one step at 1 s, the free length moving.
+    effects = {"rate_friction": {"mu_rate_s_per_mm": 0.0673}, "lumen_offset_drift": {"tip_offset_change_mm": 0.306}}
+    plant = RodPlant(description(effects=effects))
+    t = np.arange(110) * 0.01
+    amp = 4.8432 / np.sin(2 * np.pi * 1.02 / 3)
+    pitch, yaw = amp * np.sin(2 * np.pi * t / 3), amp * np.cos(2 * np.pi * t / 3) * (t > 1)
+    length = 60 + 25 * np.sin(2 * np.pi * t / 5)
+    for k in range(len(t)):
+        tip, tension = plant.step(0.01, [pitch[k], yaw[k], -pitch[k], -yaw[k]], length[k])
+    assert np.all(np.isfinite(tip)) and np.all(tension >= 0.0)
