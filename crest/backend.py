@@ -142,3 +142,10 @@ def plant_from_description(plant_toml: Path | None, effects: dict | None = None)
     from sim_backend.plant.plant_description import load_plant_description
 
     return load_plant_description(plant_toml, effects)[0]
+
+
+def plant_description_family(plant_toml: Path | None) -> str:
+    """The plant family ("dahl" or "rod") a plant TOML describes (None: configs/virtual_plant.toml, "dahl")."""
+    from sim_backend.plant.plant_description import plant_family
+
+    return "dahl" if plant_toml is None else plant_family(plant_toml)

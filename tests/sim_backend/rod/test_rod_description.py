@@ -76,3 +76,12 @@ def test_every_effect_has_a_drawable_range_around_its_typical_value():
                 assert r["draw"] == "log" or lo <= -r["high"], (effect_id, name)
     with pytest.raises(PlantDescriptionError, match="known plant families: dahl, rod"):
         plant_effect_ranges("fem")
+
+
+def test_crest_reaches_the_families_and_their_ranges_through_its_backend():
+    from crest.backend import plant_description_family, plant_effect_ranges as crest_ranges, plant_from_description
+
+    assert plant_description_family(DEFAULT_ROD_TOML) == "rod" and plant_description_family(None) == "dahl"
+    assert crest_ranges("rod") == plant_effect_ranges("rod")
+    assert set(crest_ranges("dahl")) == {e.id for e in ROD_EFFECTS.values() if e.in_catalog}
+    assert isinstance(plant_from_description(DEFAULT_ROD_TOML, {"gravity": {}}), RodPlant)
