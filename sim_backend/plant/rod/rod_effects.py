@@ -58,8 +58,8 @@ ROD_EFFECTS: dict[str, RodEffect] = {e.id: e for e in (
               "Coulomb friction of the catheter in its support tube, driven through a compliant "
               "proximal shaft: the free length moves only once the shaft force exceeds the grip, "
               "a play of +-grip_friction_n / shaft_stiffness_n_per_mm",
-              {"grip_friction_n": _p(2.0, 0.3, 6.0, "log", (0.0, 50.0)),
-               "shaft_stiffness_n_per_mm": _p(1.0, 0.5, 4.0, "log", (0.01, 1000.0))}),
+              {"grip_friction_n": _p(2.0, 0.3, 4.0, "log", (0.0, 50.0)),
+               "shaft_stiffness_n_per_mm": _p(1.0, 0.7, 3.0, "log", (0.01, 1000.0))}),
     RodEffect("gravity",
               "distributed self-weight load_n_per_mm (a fluid-filled shaft with its sensor cable, ~2x "
               "the dry shaft's 4e-4) across the insertion axis, pointing at direction_deg in the base "
@@ -78,8 +78,9 @@ ROD_EFFECTS: dict[str, RodEffect] = {e.id: e for e in (
                "sensor_z_mm": _p(1.5, 0.2, 4.0, "log_signed", (-10.0, 10.0))}),
     RodEffect("rate_friction",
               "velocity-strengthening tendon friction: mu(v) = mu (1 + mu_rate_s_per_mm |v|), v the "
-              "tendon's sliding speed at the catheter base (mm/s)",
-              {"mu_rate_s_per_mm": _p(0.1, 0.02, 1.0, "log", (0.0, 10.0))}),
+              "tendon's sliding speed at the catheter base (mm/s); drawn up to 0.3 s/mm (mu x2.5 at "
+              "5 mm/s): beyond, the tendons lock and a sweep stops on the tension limit",
+              {"mu_rate_s_per_mm": _p(0.1, 0.02, 0.3, "log", (0.0, 10.0))}),
     RodEffect("precurvature",
               "a set taken by the shaft: uniform rest curvature (rest_kappa_x, rest_kappa_y) in the "
               "body frame; the tendons were zeroed on the catheter resting in that shape",
