@@ -59,9 +59,12 @@ def _run_builtin(args, config) -> int:
         session.testbed.move_to(start_targets)        # out to the scenario's free length
         recorder = _recorder(session, args, params, f"builtin:{name} with {args.controller}")
         progress = ProgressBar(len(trajectory), f"{args.trajectory} ({args.controller})")
-        result = run_with_controller(session, trajectory, controller, recorder=recorder,
-                                     closed_loop=args.controller == "dahl+fb", on_cycle=progress.update)
-        progress.finish()
+        try:
+            result = run_with_controller(session, trajectory, controller, recorder=recorder,
+                                         closed_loop=args.controller == "dahl+fb", on_cycle=progress.update)
+            progress.finish()
+        finally:
+            progress.close()
         if recorder:
             recorder.close({"rms_tip_error_mm": result.rms_tip_error_mm})
     _report(result)
@@ -88,8 +91,11 @@ def _run_csv(args, config) -> int:
                 recorder.write(sample, tip.tip_mm if tip is not None else None)
             progress.update(done[0])
 
-        session.testbed.run_trajectory(samples, on_sample=on_sample)
-        progress.finish()
+        try:
+            session.testbed.run_trajectory(samples, on_sample=on_sample)
+            progress.finish()
+        finally:
+            progress.close()
         if recorder:
             recorder.close()
     print(f"ran {len(samples)} set-points" + (f"; log: {recorder.path}" if recorder else ""))
