@@ -8,6 +8,7 @@ import time
 import pytest
 
 from cli_runner import CREST, REPO
+from crest.exit_codes import ExitCode
 from crest.log import read_log
 
 STARTUP_TIMEOUT_S = 300.0
@@ -79,3 +80,20 @@ def test_jog_pulling_one_tendon_pays_out_its_partner_and_stops_short_of_the_tens
     pulled = log.tendon_cmd_mm[-1, 0] - log.tendon_cmd_mm[0, 0]
     assert pulled > 1.0
     assert log.tendon_cmd_mm[-1, 2] - log.tendon_cmd_mm[0, 2] == pytest.approx(-pulled, abs=1e-3)   # partner paid out
+
+
+def test_a_safety_stop_during_jog_starts_its_message_on_a_new_line():
+    master, slave = pty.openpty()
+    process = subprocess.Popen([*CREST, "jog", "--fast", "--fault", "tendon3:emcy@8.0"], cwd=REPO,
+                               stdin=slave, stdout=slave, stderr=slave, close_fds=True)
+    os.close(slave)
+    try:
+        out = read_until(master, b"L  20.0 mm", timeout_s=STARTUP_TIMEOUT_S)      # the status line is up
+        out += read_until(master, b"all axes were quick-stopped", timeout_s=120)
+        assert process.wait(timeout=60) == ExitCode.EMCY
+    finally:
+        os.close(master)
+        if process.poll() is None:
+            process.kill()
+    before_stop = out[:out.index(b"crest: safety stop")]
+    assert before_stop.endswith(b"\n"), before_stop[-200:]       # not appended to the status line
