@@ -70,12 +70,13 @@ def forecast_path_tension(params: CatheterParams, tendon_mm, insertion_mm, n_ele
 
 
 def check_path_tension(forecast: TensionForecast, max_tension_n: Sequence[float], tendon_names: Sequence[str],
-                       what: str, margin: float = DEFAULT_TENSION_MARGIN) -> None:
-    """Raise TensionLimitError naming the tendon, the tension and the limit when
+                       what: str, margin: float = DEFAULT_TENSION_MARGIN,
+                       remedy: str = "lower the articulation or use a longer free length") -> None:
+    """Raise TensionLimitError naming the tendon, the tension, the limit and the remedy when
     peak * (1 + margin) > max_tension_n for any tendon."""
     for k, (peak, limit) in enumerate(zip(forecast.peak_n, max_tension_n)):
         if peak * (1.0 + margin) > limit:
             raise TensionLimitError(
                 f"{what} refused before motion: it needs {peak:.1f} N on {tendon_names[k]} by the controller's model "
                 f"({peak * (1.0 + margin):.1f} N with the {margin:.0%} margin), above its max_tension_n "
-                f"{limit:g} N; lower the articulation or use a longer free length")
+                f"{limit:g} N; {remedy}")

@@ -42,7 +42,8 @@ def run(args: argparse.Namespace) -> int:
                                 period_s=config.sync.period_s, start=start)
     check_planned_tension(config, params, AxisTargets.from_pulls(0.0, 0.0, start.insertion_mm, workspace.pretension_mm),
                           trajectory.tendon_mm, trajectory.insertion_mm,
-                          f"move to pitch {args.pitch:g} deg, yaw {args.yaw:g} deg at free length {insertion:g} mm")
+                          f"move to pitch {args.pitch:g} deg, yaw {args.yaw:g} deg at free length {insertion:g} mm",
+                          "lower the articulation or lengthen the free length with --insertion MM")
     controller = make_controller(args.controller, workspace, limits, config.sync.period_s,
                                  loss_timeout_s=config.tracker.loss_timeout_s)
     with open_session(session_options(args)) as session:

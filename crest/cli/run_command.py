@@ -51,7 +51,8 @@ def _run_builtin(args, config) -> int:
     trajectory = builtin_trajectory(name, workspace, limits, options, period_s, start)   # refused before motion
     start_targets = AxisTargets.from_pulls(0.0, 0.0, start.insertion_mm, workspace.pretension_mm)
     check_planned_tension(config, params, start_targets, trajectory.tendon_mm, trajectory.insertion_mm,
-                          f"{args.trajectory} at {args.articulation_deg:g} deg, free length {start.insertion_mm:g} mm")
+                          f"{args.trajectory} at {args.articulation_deg:g} deg, free length {start.insertion_mm:g} mm",
+                          "lower --articulation-deg or lengthen the free length with --insertion-mm")
     controller = make_controller(args.controller, workspace, limits, period_s,
                                  loss_timeout_s=config.tracker.loss_timeout_s)
     with open_session(session_options(args)) as session:
@@ -77,7 +78,7 @@ def _run_csv(args, config) -> int:
     params = catheter_params(args)
     home = AxisTargets.from_pulls(0.0, 0.0, config.insertion_axis.home_position_mm, config.coordination.pretension_mm)
     check_planned_tension(config, params, home, [s.tendon_mm for s in samples], [s.insertion_mm for s in samples],
-                          args.trajectory)
+                          args.trajectory, "lower the pulls in the file or lengthen its free length (insertion_cmd)")
     with open_session(session_options(args)) as session:
         session.testbed.home()
         recorder = _recorder(session, args, params, f"set-points {args.trajectory}", tip_ref=False)
