@@ -10,7 +10,9 @@ from control import articulation_from_pitch_yaw, make_controller
 from control.trajectories import point_to_point
 from crest.cli.common_options import (add_controller_options, add_record_option, add_testbed_options, motion_plan,
                                       record_path, session_options)
+from crest.driver import AxisTargets
 from crest.experiment.controlled_run import run_with_controller
+from crest.experiment.planned_tension import check_planned_tension
 from crest.experiment.recorder import ExperimentRecorder
 from crest.session import open_session
 
@@ -38,6 +40,10 @@ def run(args: argparse.Namespace) -> int:
                                 tendon_velocity_mm_s=MOVE_SPEED_FRACTION * limits.tendon_velocity_mm_s,
                                 tendon_acceleration_mm_s2=MOVE_SPEED_FRACTION * limits.tendon_acceleration_mm_s2,
                                 period_s=config.sync.period_s, start=start)
+    check_planned_tension(config, params, AxisTargets.from_pulls(0.0, 0.0, start.insertion_mm, workspace.pretension_mm),
+                          trajectory.tendon_mm, trajectory.insertion_mm,
+                          f"move to pitch {args.pitch:g} deg, yaw {args.yaw:g} deg at free length {insertion:g} mm",
+                          "lower the articulation or lengthen the free length with --insertion MM")
     controller = make_controller(args.controller, workspace, limits, config.sync.period_s,
                                  loss_timeout_s=config.tracker.loss_timeout_s)
     with open_session(session_options(args)) as session:

@@ -9,9 +9,11 @@ from crest.cli.common_options import (add_controller_options, add_record_option,
                                       catheter_params, motion_plan, record_path, session_options)
 from crest.cli.progress import ProgressBar
 from crest.config import load_testbed_config
+from crest.driver import AxisTargets
 from crest.driver.motion_limits import check_trajectory
-from crest.experiment.builtin_trajectories import BUILTINS, BuiltinOptions, builtin_trajectory
+from crest.experiment.builtin_trajectories import BUILTINS, BuiltinOptions, builtin_start, builtin_trajectory
 from crest.experiment.controlled_run import run_with_controller
+from crest.experiment.planned_tension import check_planned_tension
 from crest.experiment.recorder import ExperimentRecorder
 from crest.experiment.setpoint_csv import read_setpoints
 from crest.session import open_session
@@ -45,16 +47,25 @@ def _run_builtin(args, config) -> int:
     plan = motion_plan(args)
     params, workspace, limits, period_s = plan.params, plan.workspace, plan.limits, plan.period_s
     options = BuiltinOptions(args.articulation_deg, args.plane_deg, args.insertion_mm, args.periods)
-    trajectory = builtin_trajectory(name, workspace, limits, options, period_s, plan.start)   # refused before motion
+    start = builtin_start(name, workspace, options)
+    trajectory = builtin_trajectory(name, workspace, limits, options, period_s, start)   # refused before motion
+    start_targets = AxisTargets.from_pulls(0.0, 0.0, start.insertion_mm, workspace.pretension_mm)
+    check_planned_tension(config, params, start_targets, trajectory.tendon_mm, trajectory.insertion_mm,
+                          f"{args.trajectory} at {args.articulation_deg:g} deg, free length {start.insertion_mm:g} mm",
+                          "lower --articulation-deg or lengthen the free length with --insertion-mm")
     controller = make_controller(args.controller, workspace, limits, period_s,
                                  loss_timeout_s=config.tracker.loss_timeout_s)
     with open_session(session_options(args)) as session:
         session.testbed.home()
+        session.testbed.move_to(start_targets)        # out to the scenario's free length
         recorder = _recorder(session, args, params, f"builtin:{name} with {args.controller}")
         progress = ProgressBar(len(trajectory), f"{args.trajectory} ({args.controller})")
-        result = run_with_controller(session, trajectory, controller, recorder=recorder,
-                                     closed_loop=args.controller == "dahl+fb", on_cycle=progress.update)
-        progress.finish()
+        try:
+            result = run_with_controller(session, trajectory, controller, recorder=recorder,
+                                         closed_loop=args.controller == "dahl+fb", on_cycle=progress.update)
+            progress.finish()
+        finally:
+            progress.close()
         if recorder:
             recorder.close({"rms_tip_error_mm": result.rms_tip_error_mm})
     _report(result)
@@ -65,6 +76,9 @@ def _run_csv(args, config) -> int:
     samples = read_setpoints(args.trajectory, config.sync.period_s)
     check_trajectory(config, samples)                 # refused before anything moves
     params = catheter_params(args)
+    home = AxisTargets.from_pulls(0.0, 0.0, config.insertion_axis.home_position_mm, config.coordination.pretension_mm)
+    check_planned_tension(config, params, home, [s.tendon_mm for s in samples], [s.insertion_mm for s in samples],
+                          args.trajectory, "lower the pulls in the file or lengthen its free length (insertion_cmd)")
     with open_session(session_options(args)) as session:
         session.testbed.home()
         recorder = _recorder(session, args, params, f"set-points {args.trajectory}", tip_ref=False)
@@ -78,8 +92,11 @@ def _run_csv(args, config) -> int:
                 recorder.write(sample, tip.tip_mm if tip is not None else None)
             progress.update(done[0])
 
-        session.testbed.run_trajectory(samples, on_sample=on_sample)
-        progress.finish()
+        try:
+            session.testbed.run_trajectory(samples, on_sample=on_sample)
+            progress.finish()
+        finally:
+            progress.close()
         if recorder:
             recorder.close()
     print(f"ran {len(samples)} set-points" + (f"; log: {recorder.path}" if recorder else ""))

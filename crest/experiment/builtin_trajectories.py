@@ -19,9 +19,24 @@ INSERTION_ACCELERATION_MM_S2 = 20.0
 class BuiltinOptions:
     articulation_deg: float = 90.0
     plane_deg: float = 0.0
-    insertion_mm: float | None = None    # target free length (insertion) or circle's free length
+    insertion_mm: float | None = None    # free length of sweep/history/circle, or insertion's target
     periods: float = 1.0                 # sweeps, circle turns
     circle_period_s: float = 8.0
+
+
+def builtin_start(name: str, workspace: Workspace, options: BuiltinOptions) -> Articulation:
+    """Where the scenario `name` starts: straight, at the free length it runs at.
+
+    The paper's scenarios bend to 180-270 deg, and the tension a bend needs grows as 1/L
+    (control.path_tension): at the homed free length of the insertion axis (20 mm) 120 deg already
+    needs the 40 N tendon limit. So sweep, history and circle run at --insertion-mm, by default
+    at the catheter's working free length (configs/catheter.toml free_length_mm, 80 mm, inside the
+    insertion range: `workspace.home_insertion_mm`); the insertion scenario starts there and
+    moves to --insertion-mm. The run extends the catheter to this start after homing.
+    """
+    if name != "insertion" and options.insertion_mm is not None:
+        return Articulation(0.0, 0.0, float(options.insertion_mm))
+    return workspace.home
 
 
 def builtin_trajectory(name: str, workspace: Workspace, limits: MotionLimits, options: BuiltinOptions,

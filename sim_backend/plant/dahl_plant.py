@@ -87,7 +87,14 @@ class DahlPlant:
         self.model.reset()
 
     def step(self, dt_s: float, tendon_mm, insertion_mm: float) -> tuple[np.ndarray, np.ndarray]:
-        """Advance to the drives' positions; returns (tip_mm (3,), tendon tension at the drives (4,))."""
+        """Advance to the drives' positions; returns (tip_mm (3,), tendon tension at the drives (4,)).
+
+        The free length is held inside the catheter's [min, max] free length: the insertion drive's
+        position is quantised to encoder counts, so at a soft limit equal to the catheter's maximum
+        (100 mm) it reads up to a count beyond it, and the catheter cannot leave the tube further.
+        """
         tendons = np.asarray(tendon_mm, dtype=float).reshape(1, 4) - np.asarray(self.config.tendon_zero_offsets_mm)
-        tip = self.model.run(tendons, np.array([float(insertion_mm)]), dt_s=max(float(dt_s), 1e-6))[0]
+        params = self.config.params
+        length_mm = min(max(float(insertion_mm), params.min_free_length_mm), params.max_free_length_mm)
+        tip = self.model.run(tendons, np.array([length_mm]), dt_s=max(float(dt_s), 1e-6))[0]
         return tip, np.maximum(self.model.drive_tension_n, 0.0)

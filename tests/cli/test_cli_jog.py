@@ -5,7 +5,10 @@ import select
 import subprocess
 import time
 
+import pytest
+
 from cli_runner import CREST, REPO
+from crest.exit_codes import ExitCode
 from crest.log import read_log
 
 STARTUP_TIMEOUT_S = 300.0
@@ -48,3 +51,49 @@ def test_jog_moves_pitch_and_insertion_and_releases_on_quit(tmp_path):
     log = read_log(tmp_path / "jog.csv")
     assert log.tendon_cmd_mm[-1, 0] > log.tendon_cmd_mm[-1, 2]     # tendon 1 pulled, tendon 3 paid out
     assert log.insertion_cmd_mm[-1] > log.insertion_cmd_mm[0]
+
+
+def test_jog_pulling_one_tendon_pays_out_its_partner_and_stops_short_of_the_tension_limit(tmp_path):
+    master, slave = pty.openpty()
+    process = subprocess.Popen([*CREST, "jog", "--fast", "--record", str(tmp_path / "jog.csv")], cwd=REPO,
+                               stdin=slave, stdout=slave, stderr=slave, close_fds=True)
+    os.close(slave)
+    try:
+        read_until(master, b"L  20.0 mm", timeout_s=STARTUP_TIMEOUT_S)
+        os.write(master, b"1")
+        out = b""
+        for _ in range(20):                  # 20 x 5 x 0.2 mm = 20 mm asked of tendon 1: far beyond 40 N
+            os.write(master, b"+++++")
+            out += read_until(master, b"\x1b[K", timeout_s=30)
+            assert process.poll() is None, out[-400:]
+        out += read_until(master, b"pulling refused", timeout_s=60)
+        os.write(master, b"q")
+        out += read_until(master, b"released", timeout_s=60)
+        assert process.wait(timeout=60) == 0
+    finally:
+        os.close(master)
+        if process.poll() is None:
+            process.kill()
+    assert b"tension limit: tendon1" in out
+    log = read_log(tmp_path / "jog.csv")
+    assert log.tendon_force_n.max() < 40.0                               # never near the safety stop
+    pulled = log.tendon_cmd_mm[-1, 0] - log.tendon_cmd_mm[0, 0]
+    assert pulled > 1.0
+    assert log.tendon_cmd_mm[-1, 2] - log.tendon_cmd_mm[0, 2] == pytest.approx(-pulled, abs=1e-3)   # partner paid out
+
+
+def test_a_safety_stop_during_jog_starts_its_message_on_a_new_line():
+    master, slave = pty.openpty()
+    process = subprocess.Popen([*CREST, "jog", "--fast", "--fault", "tendon3:emcy@8.0"], cwd=REPO,
+                               stdin=slave, stdout=slave, stderr=slave, close_fds=True)
+    os.close(slave)
+    try:
+        out = read_until(master, b"L  20.0 mm", timeout_s=STARTUP_TIMEOUT_S)      # the status line is up
+        out += read_until(master, b"all axes were quick-stopped", timeout_s=120)
+        assert process.wait(timeout=60) == ExitCode.EMCY
+    finally:
+        os.close(master)
+        if process.poll() is None:
+            process.kill()
+    before_stop = out[:out.index(b"crest: safety stop")]
+    assert before_stop.endswith(b"\n"), before_stop[-200:]       # not appended to the status line

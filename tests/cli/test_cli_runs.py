@@ -35,8 +35,9 @@ def test_demo_boots_homes_runs_the_paper_circle_and_records(tmp_path):
 ])
 def test_a_drive_fault_stops_every_axis_with_its_exit_code_and_keeps_the_log(tmp_path, fault, code, axis):
     log_path = tmp_path / "run.csv"
-    result = crest("run", "builtin:sweep", "--articulation-deg", "90", "--fast", "--fault", fault,
-                   "--record", str(log_path))
+    # at the homed free length (20 mm), where the sweep starts at once and the fault times were chosen
+    result = crest("run", "builtin:sweep", "--articulation-deg", "90", "--insertion-mm", "20", "--fast",
+                   "--fault", fault, "--record", str(log_path))
     assert result.returncode == code, result.stderr
     lines = [line for line in result.stderr.splitlines() if line.startswith("crest:")]
     assert len(lines) == 1 and axis in lines[0] and "Traceback" not in result.stderr
@@ -48,7 +49,7 @@ def test_a_drive_fault_stops_every_axis_with_its_exit_code_and_keeps_the_log(tmp
 
 def test_tracker_loss_in_a_closed_loop_run_stops_safely(tmp_path):
     log_path = tmp_path / "run.csv"
-    result = crest("run", "builtin:sweep", "--controller", "dahl+fb", "--fast",
+    result = crest("run", "builtin:sweep", "--controller", "dahl+fb", "--insertion-mm", "20", "--fast",
                    "--fault", "tracker:disconnect@3.0", "--record", str(log_path))
     assert result.returncode == ExitCode.TRACKER_LOST, result.stderr
     assert "tracker" in result.stderr
