@@ -53,6 +53,7 @@ class CatheterState:
     frames: np.ndarray              # (N+1, 3, 3) element base orientations
     diagnostics: np.ndarray         # (N_SCALARS,) solver counters
     bend_rate_rad_s: np.ndarray     # (N, 2) element bend velocities (dynamic mode; 0 otherwise)
+    drive_creep_mm: np.ndarray      # (4,) creep stretch of each drive line (drive_creep effect; 0 otherwise)
 
     @classmethod
     def straight(cls, n_elements: int, free_length_mm: float) -> "CatheterState":
@@ -62,7 +63,7 @@ class CatheterState:
         return cls(np.zeros(4), np.array([float(free_length_mm)]), np.zeros((4, n)), np.zeros((4, n)),
                    np.zeros((4, n)), np.zeros((4, n)), np.zeros((n, 2)), np.zeros(n), np.zeros(4),
                    np.zeros(4), np.zeros(4, dtype=np.bool_), points, np.tile(np.eye(3), (n + 1, 1, 1)),
-                   np.zeros(N_SCALARS), np.zeros((n, 2)))
+                   np.zeros(N_SCALARS), np.zeros((n, 2)), np.zeros(4))
 
     def copy(self) -> "CatheterState":
         return CatheterState(*[getattr(self, name).copy() for name in _STATE_FIELDS])
@@ -214,7 +215,7 @@ class DahlCatheter:
                         self._kernel_effects, self._point_loads, s.applied_tendon_mm, s.applied_insertion_mm,
                         s.friction_n, s.sliding_mm, s.last_step_mm, s.tension_n, s.bend_rad, s.compression_mm,
                         s.tip_tension_n, s.drive_tension_n, s.slack, s.points_mm, s.frames, s.diagnostics, tips,
-                        self.max_time_step_s, s.bend_rate_rad_s)
+                        self.max_time_step_s, s.bend_rate_rad_s, s.drive_creep_mm)
         if done < len(tendons):
             self.state = before
             raise SolverBudgetExceeded(f"the model run stopped at sample {done} of {len(tendons)}: over its budget "

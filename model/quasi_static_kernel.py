@@ -50,7 +50,7 @@ from model.jit import kernel
 
 from model.backbone_geometry import compose_backbone
 from model.dahl_friction import capstan_gain, dahl_update_with_slopes
-from model.effect_terms import (E_BACKLASH, E_GX, E_GY, E_GZ, E_KAPPA0_X, E_KAPPA0_Y, E_LUMEN_COEF,
+from model.effect_terms import (E_BACKLASH, E_CREEP_COMPLIANCE, E_CREEP_TIME, E_GX, E_GY, E_GZ, E_KAPPA0_X, E_KAPPA0_Y, E_LUMEN_COEF,
                                 E_LUMEN_EXTENT, E_RATE, E_TENDON_COMPLIANCE, E_TUBE_PLAY, E_TWIST)
 from model.linear_algebra import solve_in_place
 
@@ -367,6 +367,25 @@ def _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_scale, friction, i
 
 
 @kernel
+def drive_creep(effects, dt_s):
+    """Drive-line compliance as one step of dt_s [s] sees it, and the share of the old creep it keeps.
+
+    The drive line stretches elastically, c*T, plus a creep s_c of a standard linear solid,
+        s_c + tau ds_c/dt = c_creep T        (T the drive tension [N], tau [s], c_creep [mm/N])
+    Backward Euler over dt: s_c = (c_creep T + (tau/dt) s_c,n) / (1 + tau/dt), so the
+    compatibility equation (see _tip_tensions) takes
+        compliance = c + c_creep/(1 + tau/dt),   u_step = u - carry*s_c,n,   carry = (tau/dt)/(1 + tau/dt)
+    and s_c = carry*s_c,n + (compliance - c)*T after the step. dt = inf (a move to rest) is the
+    fully crept, purely elastic c + c_creep. Returns (compliance [mm/N], carry [-]).
+    """
+    creep_compliance = effects[E_CREEP_COMPLIANCE]
+    if creep_compliance == 0.0:
+        return effects[E_TENDON_COMPLIANCE], 0.0
+    ratio = effects[E_CREEP_TIME] / dt_s if math.isfinite(dt_s) else 0.0
+    return effects[E_TENDON_COMPLIANCE] + creep_compliance / (1.0 + ratio), ratio / (1.0 + ratio)
+
+
+@kernel
 def has_dynamics(params):
     """The dynamic mode is on when the bends have damping or inertia (CatheterParams [dynamics])."""
     return params[P_TAU] > 0.0 or params[P_INERTIA] > 0.0
@@ -432,19 +451,20 @@ def make_workspace(n):
              np.empty(4)),
             (np.empty((4, 5)), np.zeros(4, dtype=np.bool_), np.zeros(4, dtype=np.bool_), np.empty((4, 4)),
              np.empty((4, 1)), np.empty(4, dtype=np.int64)),
-            np.empty((n, 2)))
+            np.empty((n, 2)), np.empty(4))
 
 
 @kernel
 def quasi_static_step(u, length, rate_scale, params, effects, point_loads, friction, sliding, last_step, tension,
                       bend, compression, tip_tension, drive_tension, slack, points, frames, scalars, work,
-                      max_iterations, commit_unconverged, dt_s, bend_rate):
+                      max_iterations, commit_unconverged, dt_s, bend_rate, creep):
     """Advance the catheter state to equilibrium at tendon input u [mm] and free length [mm].
 
     In the dynamic mode (damping time or inertia scale > 0, see `has_dynamics`) the step is one
     backward-Euler step of dt_s [s] (inf: the quasi-static limit) of the element bends, through
     the stiffness and bend offset of `dynamic_bend_offset`; bend_rate [rad/s] is then updated.
     Without it, bend_rate is not touched and the step is the static solve, whatever dt_s is.
+    creep [mm]: the drive line's creep stretch (`drive_creep`), updated over dt_s.
 
     `rate_scale[k]` multiplies tendon k's friction strength (rate friction, 1 without it).
     `work` is scratch space from make_workspace. Returns
@@ -459,12 +479,14 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
     fsc = params[P_FSC] * h
     mu = params[P_MU]
     alpha = params[P_ALPHA]
-    compliance = effects[E_TENDON_COMPLIANCE]
 
     (arm, angle, rest_bend, ext_bend, cos_phi, sin_phi, f0, kx, gt, gth, bend_dir, xref, tref, lin_force,
      distal_force, distal_short, dist_force, dist_short, new_force, new_sliding, new_tension,
      new_bend, new_compression, increment, linear_force, revived, lengths, clamped, previous_increment,
-     crossed, slack_before, sweep_scratch, tip_scratch, dynamic_offset) = work
+     crossed, slack_before, sweep_scratch, tip_scratch, dynamic_offset, u_step) = work
+    compliance, carry = drive_creep(effects, dt_s)
+    for k in range(4):
+        u_step[k] = u[k] - carry * creep[k]
     _element_modifiers(n, length, params, effects, point_loads, tension, points, frames,
                        arm, angle, rest_bend, ext_bend)
     dynamic = has_dynamics(params)
@@ -500,7 +522,7 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
         scalars[S_ITERATIONS] += 1.0
         _sweep(n, h, kb_step, params, arm, cos_phi, sin_phi, offset, f0, kx, gt, gth, bend_dir, xref, tref, slack,
                lin_force, dist_force, dist_short, sweep_scratch)
-        if _tip_tensions(u, compliance, dist_force, dist_short, slack, revived, tip_tension, tip_scratch):
+        if _tip_tensions(u_step, compliance, dist_force, dist_short, slack, revived, tip_tension, tip_scratch):
             continue
         worst = 0.0
         finite = True          # max() drops NaN, so a diverged iterate is caught here
@@ -620,6 +642,7 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
             tension[k, i] = new_tension[k, i]
             drive += new_force[k, i]
         drive_tension[k] = drive
+        creep[k] = carry * creep[k] + (compliance - effects[E_TENDON_COMPLIANCE]) * drive
     for i in range(n):
         if dynamic:   # backward Euler: b' = (b - b_prev)/dt (0 in the quasi-static limit dt = inf)
             bend_rate[i, 0] = (new_bend[i, 0] - bend[i, 0]) / dt_s
@@ -680,7 +703,7 @@ def remap_to_length(old_length, new_length, friction, sliding, last_step, tensio
 def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_step_mm, max_iterations,
              iteration_budget, params, effects, point_loads, applied_tendon_mm, applied_insertion_mm, friction,
              sliding, last_step, tension, bend, compression, tip_tension, drive_tension, slack, points, frames,
-             scalars, tips_out, max_time_step_s, bend_rate):
+             scalars, tips_out, max_time_step_s, bend_rate, creep):
     """Drive the model along a sampled input path; tips_out[t] is the tip after sample t.
 
     Returns the number of samples done: all of them, unless the Newton iterations of this call
@@ -744,7 +767,7 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
             if quasi_static_step(u, length, rate_scale, params, effects, point_loads, friction, sliding,
                                  last_step, tension, bend, compression, tip_tension, drive_tension, slack, points,
                                  frames, scalars, work, max_iterations, fraction <= smallest, fraction * dt_s,
-                                 bend_rate):
+                                 bend_rate, creep):
                 done = w
                 fraction = min(2.0 * fraction, 1.0 / n_sub)
             else:
