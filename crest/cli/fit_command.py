@@ -20,8 +20,8 @@ def add_parser(sub) -> None:
     parser.add_argument("--out", required=True, type=Path, help="where to write the fitted catheter TOML")
     parser.add_argument("--catheter", default=None, help="starting catheter TOML (default configs/catheter.toml)")
     parser.add_argument("--dynamics", choices=list(DYNAMICS_CHOICES), default="auto",
-                        help="also fit the damping time and inertia scale: auto (when the logs' 95th-percentile "
-                             "tendon speed is >= 8 mm/s), on or off")
+                        help="also fit the damping time and inertia scale: auto (when half of the logs' "
+                             "tendon travel is at >= 8 mm/s: steps, fast multisines), on or off")
     parser.add_argument("--json", dest="json_path", type=Path, default=None,
                         help="also write the fit (values, std, correlations, flags) as JSON")
     parser.set_defaults(handler=run)

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from crest.gap.log_recordings import load_recordings
 from model import CatheterParams
-from model.gap.calibration import ModelFit, calibrate_base, is_fast, tendon_speed_p95_mm_s
+from model.gap.calibration import FAST_TENDON_SPEED_MM_S, ModelFit, calibrate_base, fast_travel_share, is_fast
 from model.gap.diagnosis import DiagnosisSettings, diagnose
 
 
@@ -34,7 +34,8 @@ def calibrate_logs(train: Sequence[Path | str], catheter_toml: Path | str | None
     say = progress or (lambda message: None)
     if fit_dynamics is None:
         fit_dynamics = is_fast(recordings)
-        say(f"fit: 95th-percentile tendon speed {tendon_speed_p95_mm_s(recordings):.1f} mm/s: "
+        say(f"fit: {100 * fast_travel_share(recordings):.0f}% of the tendon travel at >= "
+            f"{FAST_TENDON_SPEED_MM_S:g} mm/s: "
             + ("fast, fitting the damping time and inertia scale too" if fit_dynamics else "quasi-static fit"))
     with ProcessPoolExecutor(settings.workers) if settings.workers > 1 else nullcontext() as pool:
         return calibrate_base(recordings, prior, resolution=settings.resolution,

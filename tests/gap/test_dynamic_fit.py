@@ -44,6 +44,10 @@ def test_damping_time_comes_back_from_a_noiseless_fast_log():
 def test_only_fast_logs_switch_the_dynamic_fit_on():
     params = CatheterParams.from_toml()
     assert is_fast([fast_recording(params)])
+    held = fast_recording(params)
+    steps = Recording("steps", held.t_s, np.repeat(held.tendon_mm[::8], 8, axis=0), held.insertion_mm, held.tip_mm,
+                      None, params.max_free_length_mm, params.tendon_offset_mm, params.outer_diameter_mm)
+    assert is_fast([steps])
     slow = training_trajectory(Workspace.from_params(params, pretension_mm=0.02), MotionLimits(), 0.1, short=True)
     recording = Recording("slow", slow.t_s, slow.tendon_mm, slow.insertion_mm, np.zeros((len(slow.t_s), 3)), None,
                           params.max_free_length_mm, params.tendon_offset_mm, params.outer_diameter_mm)
