@@ -50,8 +50,9 @@ from model.jit import kernel
 
 from model.backbone_geometry import compose_backbone
 from model.dahl_friction import capstan_gain, dahl_update_with_slopes
-from model.effect_terms import (E_BACKLASH, E_CREEP_COMPLIANCE, E_CREEP_TIME, E_GX, E_GY, E_GZ, E_KAPPA0_X, E_KAPPA0_Y, E_LUMEN_COEF,
-                                E_LUMEN_EXTENT, E_RATE, E_TENDON_COMPLIANCE, E_TUBE_PLAY, E_TWIST)
+from model.effect_terms import (E_BACKLASH, E_CREEP_COMPLIANCE, E_CREEP_TIME, E_GX, E_GY, E_GZ, E_KAPPA0_X,
+                                E_KAPPA0_Y, E_LUMEN_COEF, E_LUMEN_EXTENT, E_RATE, E_TENDON_COMPLIANCE, E_TUBE_PLAY,
+                                E_TWIST)
 from model.linear_algebra import solve_in_place
 
 # Positions in the kernel's parameter vector (see DahlCatheter._kernel_params).

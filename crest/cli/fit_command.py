@@ -20,7 +20,7 @@ def add_parser(sub) -> None:
     parser.add_argument("--out", required=True, type=Path, help="where to write the fitted catheter TOML")
     parser.add_argument("--catheter", default=None, help="starting catheter TOML (default configs/catheter.toml)")
     parser.add_argument("--dynamics", choices=list(DYNAMICS_CHOICES), default="auto",
-                        help="also fit the damping time and inertia scale: auto (when half of the logs' "
+                        help="also fit the damping time and inertia scale: auto (when 30 %% of the logs' "
                              "tendon travel is at >= 8 mm/s: steps, fast multisines), on or off")
     parser.add_argument("--json", dest="json_path", type=Path, default=None,
                         help="also write the fit (values, std, correlations, flags) as JSON")
