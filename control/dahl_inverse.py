@@ -23,6 +23,16 @@ at 180 deg the pulls alone leave ~3 mm. The small w_L only keeps L near the set-
 the pulls suffice. The model's state is restored after every trial: solving commits nothing.
 A call costs at most max_evaluations model moves; it stops early at the tolerance, or when an
 accepted step lowers J by less than MIN_PROGRESS.
+
+The inverse stays quasi-static when the model is in its dynamic mode (CatheterParams [dynamics]):
+move_to is then a move to rest, so the solve finds the command whose settled tip is on the target,
+and the commanded model advances in time between calls. The dynamic lag it leaves is small at the
+commanded speeds (measured on the default catheter, 20 elements, 100 Hz, 30-90/120 deg cosine
+articulations, tip distance dynamic - quasi-static after the start-up second, 95th percentile):
+tau = 20 ms (inertia 1): 0.06 mm at 2 mm/s of tendon, 0.12 at 4, 0.24 at 8, 0.49 at 18 mm/s;
+tau = 50 ms: 0.15, 0.35, 0.78, 1.5 mm. Up to the slow excitation's speeds (<= 4 mm/s) that is at
+the tracker's noise; compensating the lag would need one dynamic run per trial step (a full SYNC
+period each), which the 12-evaluation budget per cycle does not allow at 100 Hz.
 """
 from __future__ import annotations
 

@@ -15,10 +15,11 @@ import numpy as np
 from model.effect_terms import EffectTerms
 from model.params import CatheterParams
 from model.quasi_static_kernel import (MAX_NEWTON_ITERATIONS, N_PARAMS, N_SCALARS, P_ALPHA, P_EA, P_EAT, P_EI,
-                                       P_FSC, P_MU, P_R, P_RHO, P_SIGMA, S_ITERATIONS, S_UNCONVERGED,
-                                       run_path)
+                                       P_FSC, P_INERTIA, P_MU, P_R, P_RHO, P_SIGMA, P_TAU, S_ITERATIONS,
+                                       S_UNCONVERGED, run_path)
 
 MIN_ELEMENTS = 4
+MAX_DYNAMIC_SAMPLE_S = 10.0   # a longer sample is a hold, not a time step: run() refuses it in the dynamic mode
 
 
 class ModelInputError(ValueError):
@@ -51,6 +52,8 @@ class CatheterState:
     points_mm: np.ndarray           # (N+1, 3) backbone
     frames: np.ndarray              # (N+1, 3, 3) element base orientations
     diagnostics: np.ndarray         # (N_SCALARS,) solver counters
+    bend_rate_rad_s: np.ndarray     # (N, 2) element bend velocities (dynamic mode; 0 otherwise)
+    drive_creep_mm: np.ndarray      # (4,) creep stretch of each drive line (drive_creep effect; 0 otherwise)
 
     @classmethod
     def straight(cls, n_elements: int, free_length_mm: float) -> "CatheterState":
@@ -60,7 +63,7 @@ class CatheterState:
         return cls(np.zeros(4), np.array([float(free_length_mm)]), np.zeros((4, n)), np.zeros((4, n)),
                    np.zeros((4, n)), np.zeros((4, n)), np.zeros((n, 2)), np.zeros(n), np.zeros(4),
                    np.zeros(4), np.zeros(4, dtype=np.bool_), points, np.tile(np.eye(3), (n + 1, 1, 1)),
-                   np.zeros(N_SCALARS))
+                   np.zeros(N_SCALARS), np.zeros((n, 2)), np.zeros(4))
 
     def copy(self) -> "CatheterState":
         return CatheterState(*[getattr(self, name).copy() for name in _STATE_FIELDS])
@@ -81,16 +84,23 @@ class DahlCatheter:
     `max_tendon_step_mm` of tendon and `max_insertion_step_mm` of insertion, so the friction
     history follows the path; a sub-step whose Newton solve needs more than
     `max_newton_iterations` is retried in halves.
+
+    Dynamic mode (params.dynamic: a damping time or an inertia scale > 0, seed paper I.A): `run`
+    integrates the element bends in time, M b'' + C b' + K b = tendon, friction and external
+    moments, by backward Euler (implicit, L-stable) in steps of at most `max_time_step_s`;
+    `move_to` is a move to rest (the quasi-static limit). Math: quasi_static_kernel.dynamic_bend_offset.
     """
 
     def __init__(self, params: CatheterParams, n_elements: int = 20, effects: EffectTerms = EffectTerms(),
                  max_tendon_step_mm: float = 0.05, max_insertion_step_mm: float = 0.5,
-                 max_newton_iterations: int = MAX_NEWTON_ITERATIONS):
+                 max_newton_iterations: int = MAX_NEWTON_ITERATIONS, max_time_step_s: float = 0.005):
         if isinstance(n_elements, bool) or not isinstance(n_elements, (int, np.integer)) \
                 or n_elements < MIN_ELEMENTS:
             raise ValueError(f"n_elements must be an integer >= {MIN_ELEMENTS}, got {n_elements!r}")
         if not (max_tendon_step_mm > 0 and max_insertion_step_mm > 0):
             raise ValueError("max_tendon_step_mm and max_insertion_step_mm must be > 0")
+        if not 0 < max_time_step_s < math.inf:
+            raise ValueError(f"max_time_step_s must be a finite time > 0 s, got {max_time_step_s!r}")
         if not max_newton_iterations >= 1:
             raise ValueError(f"max_newton_iterations must be >= 1, got {max_newton_iterations!r}")
         self.params = params
@@ -99,6 +109,7 @@ class DahlCatheter:
         self.max_tendon_step_mm = float(max_tendon_step_mm)
         self.max_insertion_step_mm = float(max_insertion_step_mm)
         self.max_newton_iterations = int(max_newton_iterations)
+        self.max_time_step_s = float(max_time_step_s)
         self._kernel_params = self._pack(params)
         self._kernel_effects = effects.kernel_vector()
         self._tracker_offset_mm = np.asarray(effects.tracker_offset_mm, dtype=float)
@@ -117,6 +128,8 @@ class DahlCatheter:
         v[P_SIGMA] = p.sigma_n_per_mm2
         v[P_ALPHA] = p.alpha
         v[P_RHO] = p.linear_density_kg_per_mm
+        v[P_TAU] = p.damping_time_s
+        v[P_INERTIA] = p.inertia_scale
         return v
 
     # -- state -------------------------------------------------------------------------
@@ -163,6 +176,7 @@ class DahlCatheter:
         """Drive quasi-statically from the current state to this input; returns the tip [mm].
 
         History carries over: the friction state evolves along the straight-line input path.
+        In the dynamic mode this is a move slow enough to end at rest (the quasi-static limit).
         """
         if insertion_mm is None:
             insertion_mm = float(self.state.applied_insertion_mm[0])
@@ -174,7 +188,8 @@ class DahlCatheter:
             max_solver_iterations: float = math.inf) -> np.ndarray:
         """Drive along a sampled input path tendons_mm[T, 4], insertion_mm[T]; tips [T, 3] in mm.
 
-        dt_s is the sample period; it matters only for rate-dependent effects.
+        dt_s is the sample period [s]; it matters for rate-dependent effects and, in the dynamic
+        mode, is the time each sample takes (then it must be finite: at most 10 s).
         max_solver_iterations: SolverBudgetExceeded (state unchanged) as soon as the run has taken
         more Newton iterations; a measure of work that, unlike time, does not depend on the machine.
         """
@@ -184,6 +199,10 @@ class DahlCatheter:
         tendons, insertion = self._validated(tendons, np.asarray(insertion_mm, dtype=float))
         if not (dt_s > 0):
             raise ModelInputError(f"dt_s must be > 0, got {dt_s!r}")
+        if self.params.dynamic and not dt_s <= MAX_DYNAMIC_SAMPLE_S:
+            raise ModelInputError(f"dt_s = {dt_s!r} s: the dynamic mode integrates in time and needs a finite "
+                                  f"sample period of at most {MAX_DYNAMIC_SAMPLE_S:g} s (use move_to for a move "
+                                  "to rest)")
         return self._run(tendons, insertion, float(dt_s), float(max_solver_iterations))
 
     def _run(self, tendons: np.ndarray, insertion: np.ndarray, dt_s: float,
@@ -195,7 +214,8 @@ class DahlCatheter:
                         self.max_newton_iterations, max_solver_iterations, self._kernel_params,
                         self._kernel_effects, self._point_loads, s.applied_tendon_mm, s.applied_insertion_mm,
                         s.friction_n, s.sliding_mm, s.last_step_mm, s.tension_n, s.bend_rad, s.compression_mm,
-                        s.tip_tension_n, s.drive_tension_n, s.slack, s.points_mm, s.frames, s.diagnostics, tips)
+                        s.tip_tension_n, s.drive_tension_n, s.slack, s.points_mm, s.frames, s.diagnostics, tips,
+                        self.max_time_step_s, s.bend_rate_rad_s, s.drive_creep_mm)
         if done < len(tendons):
             self.state = before
             raise SolverBudgetExceeded(f"the model run stopped at sample {done} of {len(tendons)}: over its budget "

@@ -27,7 +27,9 @@ E_TWIST = 8
 E_RATE = 9
 E_KAPPA0_X = 10
 E_KAPPA0_Y = 11
-N_KERNEL_TERMS = 12
+E_CREEP_COMPLIANCE = 12
+E_CREEP_TIME = 13
+N_KERNEL_TERMS = 14
 
 
 @dataclass(frozen=True)
@@ -45,6 +47,9 @@ class EffectTerms:
     rate_friction_s_per_mm: velocity-strengthening friction, Fs*(1 + c*|v|), v the tendon's pull
         speed in mm/s.
     precurvature_per_mm: residual rest curvature (kx, ky) of the unactuated catheter.
+    drive_creep_mm_per_n, drive_creep_time_s: viscoelastic creep of the drive line (standard
+        linear solid): a stretch s_c with s_c + tau*ds_c/dt = c_creep*T_drive, in series with the
+        elastic stretch, so the tip sees u - c*T_drive - s_c (quasi_static_kernel.drive_creep).
     tracker_offset_mm: rigid registration error of the tip sensor (added to the tip).
     """
 
@@ -57,6 +62,8 @@ class EffectTerms:
     twist_rad: float = 0.0
     rate_friction_s_per_mm: float = 0.0
     precurvature_per_mm: tuple[float, float] = (0.0, 0.0)
+    drive_creep_mm_per_n: float = 0.0
+    drive_creep_time_s: float = 0.2
     tracker_offset_mm: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def __post_init__(self) -> None:
@@ -66,11 +73,13 @@ class EffectTerms:
             if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in values):
                 raise ValueError(f"effect term '{field.name}' must be finite, got {value!r}")
         for name in ("tendon_compliance_mm_per_n", "backlash_mm", "lumen_compression_per_n",
-                     "tube_play_mm", "rate_friction_s_per_mm"):
+                     "tube_play_mm", "rate_friction_s_per_mm", "drive_creep_mm_per_n"):
             if getattr(self, name) < 0:
                 raise ValueError(f"effect term '{name}' must be >= 0, got {getattr(self, name)}")
         if self.lumen_compression_extent_mm <= 0:
             raise ValueError("effect term 'lumen_compression_extent_mm' must be > 0")
+        if self.drive_creep_time_s <= 0:
+            raise ValueError("effect term 'drive_creep_time_s' must be > 0")
 
     def replace(self, **changes) -> "EffectTerms":
         return dataclasses.replace(self, **changes)
@@ -87,4 +96,6 @@ class EffectTerms:
         v[E_TWIST] = self.twist_rad
         v[E_RATE] = self.rate_friction_s_per_mm
         v[E_KAPPA0_X:E_KAPPA0_Y + 1] = self.precurvature_per_mm
+        v[E_CREEP_COMPLIANCE] = self.drive_creep_mm_per_n
+        v[E_CREEP_TIME] = self.drive_creep_time_s
         return v

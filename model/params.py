@@ -21,6 +21,7 @@ _SECTIONS = {
     "stiffness": ("bending_stiffness_nmm2", "axial_stiffness_n", "tendon_stiffness_n",
                   "linear_density_kg_per_mm"),
     "friction": ("mu", "fsc_n_per_mm", "sigma_n_per_mm2", "alpha"),
+    "dynamics": ("damping_time_s", "inertia_scale"),
 }
 
 
@@ -36,6 +37,12 @@ class CatheterParams:
     elements N (seed paper II.B, "invariant to the number of discrete elements"): with
     element length h = L/N, bending stiffness EI/h [N*mm/rad], axial stiffness EA/h [N/mm],
     Dahl stiffness sigma*h [N/mm], constant friction Fsc*h [N] and mass density*h [kg].
+
+    Dynamics (seed paper I.A, Fig. 1; both 0 = the quasi-static model, the default):
+    damping_time_s is the Kelvin-Voigt time tau = eta/EI of the bending dampers (per element
+    c = tau*EI/h), inertia_scale scales the bend inertia that gives each element the first
+    bending mode of a clamped-free beam of linear_density_kg_per_mm (per element
+    m = scale * rho*L^4 / (12.362*h)); see model.quasi_static_kernel.dynamic_bend_offset.
     """
 
     outer_diameter_mm: float = 6.0
@@ -52,6 +59,8 @@ class CatheterParams:
     fsc_n_per_mm: float = 0.005
     sigma_n_per_mm2: float = 1.0
     alpha: float = 1.0
+    damping_time_s: float = 0.0
+    inertia_scale: float = 0.0
 
     def __post_init__(self) -> None:
         for field in dataclasses.fields(self):
@@ -66,7 +75,7 @@ class CatheterParams:
         for name in positive:
             if getattr(self, name) <= 0:
                 raise ParamsError(f"catheter parameter '{name}' must be > 0, got {getattr(self, name)!r}")
-        for name in ("mu", "fsc_n_per_mm", "linear_density_kg_per_mm"):
+        for name in ("mu", "fsc_n_per_mm", "linear_density_kg_per_mm", "damping_time_s", "inertia_scale"):
             if getattr(self, name) < 0:
                 raise ParamsError(f"catheter parameter '{name}' must be >= 0, got {getattr(self, name)!r}")
         if self.tendon_offset_mm >= self.outer_diameter_mm / 2:
@@ -79,6 +88,11 @@ class CatheterParams:
         if len(self.tendon_range_mm) != 2 or not self.tendon_range_mm[0] < self.tendon_range_mm[1]:
             raise ParamsError(f"catheter parameter 'tendon_range_mm' must be [min, max] with min < max, "
                               f"got {self.tendon_range_mm!r}")
+
+    @property
+    def dynamic(self) -> bool:
+        """The dynamic mode is on exactly when the bends have damping or inertia."""
+        return self.damping_time_s > 0 or self.inertia_scale > 0
 
     @property
     def friction_enabled(self) -> bool:
@@ -94,7 +108,7 @@ class CatheterParams:
 
     @classmethod
     def from_toml(cls, path: str | Path = DEFAULT_CATHETER_TOML) -> "CatheterParams":
-        """Load parameters from a TOML file with [geometry], [stiffness] and [friction] tables.
+        """Load parameters from a TOML file with [geometry], [stiffness], [friction] and [dynamics] tables.
 
         Keys may also sit at the top level. Missing keys keep their defaults; unknown keys
         and bad values raise ParamsError naming the file and the field.

@@ -8,6 +8,10 @@ K_b = EI/h [N*mm/rad], K_a = EA/h [N/mm]. The kernel is linear; cost grows linea
 Quasi-static motion (paper I.A). Inertia and damping forces vanish at quasi-static rates,
 so each step solves static equilibrium; the path still matters through the friction state.
 The element masses (density*h) enter as gravity loads through the contact Jacobian.
+Dynamic mode (paper I.A, Fig. 1: M q'' + C q' + K q = f with diagonal M and C): with a damping
+time or an inertia scale set, each step is one backward-Euler step of the element bends, which
+only stiffens each element's bend spring and shifts the bend it acts about
+(`dynamic_bend_offset`); the solve below is otherwise the same.
 
 Tendons (paper II.A-B). Tendon k sits at radius r and angle phi_k = (k-1)*90 deg (plus the
 twist term), is fixed at the tip and pulled by u_k [mm] at the base. Its tension just
@@ -46,8 +50,9 @@ from model.jit import kernel
 
 from model.backbone_geometry import compose_backbone
 from model.dahl_friction import capstan_gain, dahl_update_with_slopes
-from model.effect_terms import (E_BACKLASH, E_GX, E_GY, E_GZ, E_KAPPA0_X, E_KAPPA0_Y, E_LUMEN_COEF,
-                                E_LUMEN_EXTENT, E_RATE, E_TENDON_COMPLIANCE, E_TUBE_PLAY, E_TWIST)
+from model.effect_terms import (E_BACKLASH, E_CREEP_COMPLIANCE, E_CREEP_TIME, E_GX, E_GY, E_GZ, E_KAPPA0_X,
+                                E_KAPPA0_Y, E_LUMEN_COEF, E_LUMEN_EXTENT, E_RATE, E_TENDON_COMPLIANCE, E_TUBE_PLAY,
+                                E_TWIST)
 from model.linear_algebra import solve_in_place
 
 # Positions in the kernel's parameter vector (see DahlCatheter._kernel_params).
@@ -60,13 +65,16 @@ P_FSC = 5      # constant friction per mm of length, N/mm
 P_SIGMA = 6    # Dahl stiffness per mm of length, N/mm^2
 P_ALPHA = 7    # Dahl exponent
 P_RHO = 8      # linear density, kg/mm
-N_PARAMS = 9
+P_TAU = 9      # bending damping time constant tau = eta/EI, s (dynamic mode)
+P_INERTIA = 10  # inertia scale on the first-mode inertia of the linear density (dynamic mode)
+N_PARAMS = 11
 
 # Positions in the state's diagnostics vector.
 S_ITERATIONS = 0    # Newton iterations used in total
 S_UNCONVERGED = 1   # steps that hit the iteration limit
 N_SCALARS = 2
 
+CANTILEVER_MODE_1 = 12.362   # (beta_1 L)^4 = 1.8751^4: first bending mode of a clamped-free beam
 MAX_NEWTON_ITERATIONS = 12   # default Newton iterations of a sub-step before it is retried in halves
 MAX_HALVINGS = 10   # an unconverged sub-step is retried in halves, down to 1/1024 of it
 MAX_TENSION_STEP_N = 1.0  # a sub-step switching slack tendons and a drive tension by more is retried in halves
@@ -160,7 +168,7 @@ def _add_load(q0, q1, q2, f0, f1, f2, sum_f, sum_pxf):
 
 
 @kernel
-def _sweep(n, h, params, arm, cos_phi, sin_phi, ext_bend, f0, kx, gt, gth, bend_dir, xref, tref, slack,
+def _sweep(n, h, kb, params, arm, cos_phi, sin_phi, ext_bend, f0, kx, gt, gth, bend_dir, xref, tref, slack,
            lin_force, dist_force, dist_short, scratch):
     """Tip-to-base sweep: affine maps (4 x 5: constant, then d/dT_tip) of the friction forces.
 
@@ -178,8 +186,9 @@ def _sweep(n, h, params, arm, cos_phi, sin_phi, ext_bend, f0, kx, gt, gth, bend_
     gth_k * dtheta/dT_m with dtheta/dT_m = (r/K_b) (u . e_m), u the unit bend direction.
     So I - G/2 = Delta - (1/2) gth w^T: diagonal plus rank one (`_solve_diagonal_plus_rank_one`).
     A slack tendon's row is F = 0.
+    kb is the element's bending stiffness as the step sees it (K_b, or K_b + m/dt^2 + c/dt in the
+    dynamic mode) and ext_bend the bend offset it acts about (see dynamic_bend_offset).
     """
-    kb = params[P_EI] / h
     ka = h / params[P_EA]
     kt = h / params[P_EAT]
     inv_diag, coupling, rhs, pull, dp, w_pull, d0, w = scratch
@@ -359,6 +368,77 @@ def _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_scale, friction, i
 
 
 @kernel
+def drive_creep(effects, dt_s):
+    """Drive-line compliance as one step of dt_s [s] sees it, and the share of the old creep it keeps.
+
+    The drive line stretches elastically, c*T, plus a creep s_c of a standard linear solid,
+        s_c + tau ds_c/dt = c_creep T        (T the drive tension [N], tau [s], c_creep [mm/N])
+    Backward Euler over dt: s_c = (c_creep T + (tau/dt) s_c,n) / (1 + tau/dt), so the
+    compatibility equation (see _tip_tensions) takes
+        compliance = c + c_creep/(1 + tau/dt),   u_step = u - carry*s_c,n,   carry = (tau/dt)/(1 + tau/dt)
+    and s_c = carry*s_c,n + (compliance - c)*T after the step. dt = inf (a move to rest) is the
+    fully crept, purely elastic c + c_creep. Returns (compliance [mm/N], carry [-]).
+    """
+    creep_compliance = effects[E_CREEP_COMPLIANCE]
+    if creep_compliance == 0.0:
+        return effects[E_TENDON_COMPLIANCE], 0.0
+    ratio = effects[E_CREEP_TIME] / dt_s if math.isfinite(dt_s) else 0.0
+    return effects[E_TENDON_COMPLIANCE] + creep_compliance / (1.0 + ratio), ratio / (1.0 + ratio)
+
+
+@kernel
+def has_dynamics(params):
+    """The dynamic mode is on when the bends have damping or inertia (CatheterParams [dynamics])."""
+    return params[P_TAU] > 0.0 or params[P_INERTIA] > 0.0
+
+
+@kernel
+def dynamic_bend_offset(length, kb, dt_s, params, rest_bend, ext_bend, bend, bend_rate, offset):
+    """One backward-Euler step of the element bends (seed paper I.A, Fig. 1): stiffness and offset.
+
+    Each element's bend b_i (2-vector, rad) obeys M q'' + C q' + K q = f with diagonal M and C
+    (paper I.A: "a decoupled, diagonal mass matrix"), the tendon moments r*sum_k T_ki e_k as the
+    control input (the tendon tensions are whatever balances the spring, damper and inertia forces,
+    paper II.B), friction through those tensions, and external loads in K_b b_ext:
+
+        m b'' + c b' + K_b (b - b_rest - b_ext) = r sum_k T_ki e_k
+
+    Per element of length h = L/N, with the Kelvin-Voigt damping time tau = eta/EI [s] and the
+    inertia scale s_m [-]:
+        K_b = EI/h [N*mm/rad],  c = tau*K_b [N*mm*s/rad],
+        m = s_m * 1e-3 * rho*L^4 / (12.362*h) [N*mm*s^2/rad]   (rho in kg/mm; 1 N*mm*s^2 = 1e3 kg*mm^2)
+    so that sqrt(K_b/m) = sqrt(12.362*EI/(rho*L^4)) (x sqrt(1/s_m)) is the first bending mode of the
+    clamped-free beam of this density, and tau and the damping ratio zeta = tau*omega/2 are the
+    same in every element: the response does not depend on N (paper II.B, invariance to N).
+    Backward Euler over dt [s] (implicit, L-stable: no overshoot or ringing from the integrator),
+        b' = (b - b_n)/dt,   b'' = (b - b_n)/dt^2 - b_n'/dt,
+    turns the element equation into the static one with a stiffer spring about a shifted bend:
+        K_step = K_b + a,   a = m/dt^2 + c/dt
+        b - b_rest = offset + (r/K_step) sum_k T_ki e_k,
+        offset = (K_b b_ext + a (b_n - b_rest) + (m/dt) b_n') / K_step
+    Both are per-element constants within the step, so the tip-to-base sweep, the 4x4
+    compatibility solve and the cost linear in N stay as they are. dt = inf gives a = 0:
+    the quasi-static solution. The axial springs stay static (EA/h is some 10^5 times K_b/r^2;
+    their mode is far above any sample rate). Writes offset, returns K_step.
+    """
+    n = bend.shape[0]
+    h = length / n
+    inertia = params[P_INERTIA] * 1e-3 * params[P_RHO] * length ** 4 / (CANTILEVER_MODE_1 * h)
+    damping = params[P_TAU] * kb
+    if math.isfinite(dt_s):
+        a = inertia / (dt_s * dt_s) + damping / dt_s
+        carry = inertia / dt_s
+    else:
+        a = 0.0
+        carry = 0.0
+    k_step = kb + a
+    for i in range(n):
+        for j in range(2):
+            offset[i, j] = (kb * ext_bend[i, j] + a * (bend[i, j] - rest_bend[i, j]) + carry * bend_rate[i, j]) / k_step
+    return k_step
+
+
+@kernel
 def make_workspace(n):
     """Scratch arrays for quasi_static_step, allocated once per run."""
     return (np.empty(n), np.empty(n), np.empty((n, 2)), np.empty((n, 2)), np.empty((n, 4)), np.empty((n, 4)),
@@ -371,14 +451,21 @@ def make_workspace(n):
             (np.empty(4), np.empty(4), np.empty((4, 5)), np.empty((4, 5)), np.empty((4, 5)), np.empty(5), np.empty(4),
              np.empty(4)),
             (np.empty((4, 5)), np.zeros(4, dtype=np.bool_), np.zeros(4, dtype=np.bool_), np.empty((4, 4)),
-             np.empty((4, 1)), np.empty(4, dtype=np.int64)))
+             np.empty((4, 1)), np.empty(4, dtype=np.int64)),
+            np.empty((n, 2)), np.empty(4))
 
 
 @kernel
 def quasi_static_step(u, length, rate_scale, params, effects, point_loads, friction, sliding, last_step, tension,
                       bend, compression, tip_tension, drive_tension, slack, points, frames, scalars, work,
-                      max_iterations, commit_unconverged):
+                      max_iterations, commit_unconverged, dt_s, bend_rate, creep):
     """Advance the catheter state to equilibrium at tendon input u [mm] and free length [mm].
+
+    In the dynamic mode (damping time or inertia scale > 0, see `has_dynamics`) the step is one
+    backward-Euler step of dt_s [s] (inf: the quasi-static limit) of the element bends, through
+    the stiffness and bend offset of `dynamic_bend_offset`; bend_rate [rad/s] is then updated.
+    Without it, bend_rate is not touched and the step is the static solve, whatever dt_s is.
+    creep [mm]: the drive line's creep stretch (`drive_creep`), updated over dt_s.
 
     `rate_scale[k]` multiplies tendon k's friction strength (rate friction, 1 without it).
     `work` is scratch space from make_workspace. Returns
@@ -393,14 +480,23 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
     fsc = params[P_FSC] * h
     mu = params[P_MU]
     alpha = params[P_ALPHA]
-    compliance = effects[E_TENDON_COMPLIANCE]
 
     (arm, angle, rest_bend, ext_bend, cos_phi, sin_phi, f0, kx, gt, gth, bend_dir, xref, tref, lin_force,
      distal_force, distal_short, dist_force, dist_short, new_force, new_sliding, new_tension,
      new_bend, new_compression, increment, linear_force, revived, lengths, clamped, previous_increment,
-     crossed, slack_before, sweep_scratch, tip_scratch) = work
+     crossed, slack_before, sweep_scratch, tip_scratch, dynamic_offset, u_step) = work
+    compliance, carry = drive_creep(effects, dt_s)
+    for k in range(4):
+        u_step[k] = u[k] - carry * creep[k]
     _element_modifiers(n, length, params, effects, point_loads, tension, points, frames,
                        arm, angle, rest_bend, ext_bend)
+    dynamic = has_dynamics(params)
+    offset = ext_bend          # bend about which the tendons act, minus the rest bend
+    kb_step = kb               # the element's stiffness as this step sees it
+    if dynamic:
+        kb_step = dynamic_bend_offset(length, kb, dt_s, params, rest_bend, ext_bend, bend, bend_rate,
+                                      dynamic_offset)
+        offset = dynamic_offset
     for i in range(n):  # tendon k at phi_k = k*90 deg + twist offset
         c = math.cos(angle[i]) if angle[i] != 0.0 else 1.0
         s = math.sin(angle[i]) if angle[i] != 0.0 else 0.0
@@ -425,9 +521,9 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
     converged = False
     for iteration in range(max_iterations):
         scalars[S_ITERATIONS] += 1.0
-        _sweep(n, h, params, arm, cos_phi, sin_phi, ext_bend, f0, kx, gt, gth, bend_dir, xref, tref, slack,
+        _sweep(n, h, kb_step, params, arm, cos_phi, sin_phi, offset, f0, kx, gt, gth, bend_dir, xref, tref, slack,
                lin_force, dist_force, dist_short, sweep_scratch)
-        if _tip_tensions(u, compliance, dist_force, dist_short, slack, revived, tip_tension, tip_scratch):
+        if _tip_tensions(u_step, compliance, dist_force, dist_short, slack, revived, tip_tension, tip_scratch):
             continue
         worst = 0.0
         finite = True          # max() drops NaN, so a diverged iterate is caught here
@@ -438,9 +534,9 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
             distal_short[k] = 0.0
         for i in range(n - 1, -1, -1):   # tip to base: tensions add the distal friction forces
             r = arm[i]
-            c = r * r / kb
-            bx = rest_bend[i, 0] + ext_bend[i, 0]
-            by = rest_bend[i, 1] + ext_bend[i, 1]
+            c = r * r / kb_step
+            bx = rest_bend[i, 0] + offset[i, 0]
+            by = rest_bend[i, 1] + offset[i, 1]
             total = 0.0
             along0 = 0.0
             along1 = 0.0
@@ -461,15 +557,15 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
                 total += t
                 along0 += t * cos_phi[i, k]
                 along1 += t * sin_phi[i, k]
-            bx += r / kb * along0
-            by += r / kb * along1
+            bx += r / kb_step * along0
+            by += r / kb_step * along1
             new_bend[i, 0] = bx
             new_bend[i, 1] = by
             new_compression[i] = ka * total
             for k in range(4):
                 # delta = D T + d0 with D = ka*J + (r^2/K_b) E E^T + kt*I, for the mean tension T
                 # (whole element) and for the distal half's tension P (sliding at the centre)
-                external = r * (ext_bend[i, 0] * cos_phi[i, k] + ext_bend[i, 1] * sin_phi[i, k])
+                external = r * (offset[i, 0] * cos_phi[i, k] + offset[i, 1] * sin_phi[i, k])
                 shortening = (ka * total + c * (cos_phi[i, k] * along0 + sin_phi[i, k] * along1)
                               + kt * new_tension[k, i] + external)
                 distal_half = (ka * distal_total + c * (cos_phi[i, k] * distal_along0 + sin_phi[i, k] * distal_along1)
@@ -547,7 +643,11 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
             tension[k, i] = new_tension[k, i]
             drive += new_force[k, i]
         drive_tension[k] = drive
+        creep[k] = carry * creep[k] + (compliance - effects[E_TENDON_COMPLIANCE]) * drive
     for i in range(n):
+        if dynamic:   # backward Euler: b' = (b - b_prev)/dt (0 in the quasi-static limit dt = inf)
+            bend_rate[i, 0] = (new_bend[i, 0] - bend[i, 0]) / dt_s
+            bend_rate[i, 1] = (new_bend[i, 1] - bend[i, 1]) / dt_s
         bend[i, 0] = new_bend[i, 0]
         bend[i, 1] = new_bend[i, 1]
         compression[i] = new_compression[i]
@@ -604,7 +704,7 @@ def remap_to_length(old_length, new_length, friction, sliding, last_step, tensio
 def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_step_mm, max_iterations,
              iteration_budget, params, effects, point_loads, applied_tendon_mm, applied_insertion_mm, friction,
              sliding, last_step, tension, bend, compression, tip_tension, drive_tension, slack, points, frames,
-             scalars, tips_out):
+             scalars, tips_out, max_time_step_s, bend_rate, creep):
     """Drive the model along a sampled input path; tips_out[t] is the tip after sample t.
 
     Returns the number of samples done: all of them, unless the Newton iterations of this call
@@ -623,6 +723,11 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
     dt_s = inf, a purely quasi-static move). The scale is known before the solve, so it adds
     no discontinuity to Newton's system (a scale on each element's own sliding increment did,
     at every reversal).
+
+    Dynamic mode (`has_dynamics`): the input is linear in time over each sample, so a sub-step
+    that covers the fraction w of the sample is a backward-Euler step of w*dt_s seconds; samples
+    are also split so that no step exceeds max_time_step_s. dt_s = inf (a move to rest) is one
+    quasi-static solve.
     """
     n_samples = tendon_mm.shape[0]
     target = np.empty(4)
@@ -630,6 +735,7 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
     rate_scale = np.ones(4)
     rate_per_mm = effects[E_RATE] / dt_s if (dt_s > 0.0 and math.isfinite(dt_s)) else 0.0
     work = make_workspace(bend.shape[0])
+    dynamic = has_dynamics(params)
     stop_at_iterations = scalars[S_ITERATIONS] + iteration_budget
     for t in range(n_samples):
         for k in range(4):
@@ -641,6 +747,8 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
             rate_scale[k] = 1.0 + rate_per_mm * abs(target[k] - applied_tendon_mm[k])
         n_sub = max(1, int(math.ceil(span / max_tendon_step_mm)),
                     int(math.ceil(abs(length_target - applied_insertion_mm[0]) / max_insertion_step_mm)))
+        if dynamic and math.isfinite(dt_s):
+            n_sub = max(n_sub, int(math.ceil(dt_s / max_time_step_s - 1e-9)))
         start_length = applied_insertion_mm[0]
         start = applied_tendon_mm.copy()
         length = start_length
@@ -659,7 +767,8 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
             remap_to_length(previous_length, length, friction, sliding, last_step, tension)
             if quasi_static_step(u, length, rate_scale, params, effects, point_loads, friction, sliding,
                                  last_step, tension, bend, compression, tip_tension, drive_tension, slack, points,
-                                 frames, scalars, work, max_iterations, fraction <= smallest):
+                                 frames, scalars, work, max_iterations, fraction <= smallest, fraction * dt_s,
+                                 bend_rate, creep):
                 done = w
                 fraction = min(2.0 * fraction, 1.0 / n_sub)
             else:

@@ -1,4 +1,4 @@
-"""Benchmarks of the model: step rate, real-time factor, cost against N, one quasi-static move."""
+"""Benchmarks of the model: step rate (quasi-static and dynamic), real-time factor, cost against N, one move."""
 from __future__ import annotations
 
 import time
@@ -38,6 +38,19 @@ def model_step(params: CatheterParams) -> dict:
     return {"n_elements": 20, "samples": len(path), "wall_s": wall_s,
             "step_rate_hz": len(path) / wall_s, "real_time_factor": duration_s / wall_s,
             "goal_real_time_factor": 1000.0}
+
+
+def dynamic_model_step(params: CatheterParams, damping_time_s: float = 0.02, inertia_scale: float = 1.0) -> dict:
+    """model_step in the dynamic mode (backward Euler, steps of at most 5 ms: two per 10 ms sample).
+
+    Unless the parameters already set them, a 20 ms damping time and the catheter's own mass.
+    """
+    if not params.dynamic:
+        params = params.replace(damping_time_s=damping_time_s, inertia_scale=inertia_scale)
+    result = model_step(params)
+    result.update(damping_time_s=params.damping_time_s, inertia_scale=params.inertia_scale,
+                  max_time_step_s=DahlCatheter(params, 20).max_time_step_s)
+    return result
 
 
 def scaling_in_n(params: CatheterParams, sizes=(10, 20, 40, 80, 160, 320)) -> dict:

@@ -9,7 +9,9 @@ from pathlib import Path
 from crest.gap.log_diagnosis import calibrate_logs, prior_catheter
 from model.gap.diagnosis import DiagnosisSettings
 
-FITTED = ("bending_stiffness_nmm2", "axial_stiffness_n", "mu", "sigma_n_per_mm2", "fsc_n_per_mm")
+FITTED = ("bending_stiffness_nmm2", "axial_stiffness_n", "mu", "sigma_n_per_mm2", "fsc_n_per_mm",
+          "damping_time_s", "inertia_scale")
+DYNAMICS_CHOICES = {"auto": None, "on": True, "off": False}
 
 
 def add_parser(sub) -> None:
@@ -17,6 +19,9 @@ def add_parser(sub) -> None:
     parser.add_argument("train", nargs="+", type=Path, help="training logs (crest-log/1 CSV with JSON sidecar)")
     parser.add_argument("--out", required=True, type=Path, help="where to write the fitted catheter TOML")
     parser.add_argument("--catheter", default=None, help="starting catheter TOML (default configs/catheter.toml)")
+    parser.add_argument("--dynamics", choices=list(DYNAMICS_CHOICES), default="auto",
+                        help="also fit the damping time and inertia scale: auto (when 30 %% of the logs' "
+                             "tendon travel is at >= 8 mm/s: steps, fast multisines), on or off")
     parser.add_argument("--json", dest="json_path", type=Path, default=None,
                         help="also write the fit (values, std, correlations, flags) as JSON")
     parser.set_defaults(handler=run)
@@ -24,7 +29,8 @@ def add_parser(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     fit = calibrate_logs(args.train, args.catheter, DiagnosisSettings(),
-                         progress=lambda message: print(f"crest fit: {message}", file=sys.stderr, flush=True))
+                         progress=lambda message: print(f"crest fit: {message}", file=sys.stderr, flush=True),
+                         fit_dynamics=DYNAMICS_CHOICES[args.dynamics])
     prior = prior_catheter(args.catheter)
     fitted = prior.replace(tendon_offset_mm=fit.params.tendon_offset_mm,
                            outer_diameter_mm=fit.params.outer_diameter_mm,

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from crest.gap.log_recordings import load_recordings
 from model import CatheterParams
-from model.gap.calibration import ModelFit, calibrate_base
+from model.gap.calibration import FAST_TENDON_SPEED_MM_S, ModelFit, calibrate_base, fast_travel_share, is_fast
 from model.gap.diagnosis import DiagnosisSettings, diagnose
 
 
@@ -23,15 +23,25 @@ def prior_catheter(catheter_toml: Path | str | None) -> CatheterParams:
 
 def calibrate_logs(train: Sequence[Path | str], catheter_toml: Path | str | None = None,
                    settings: DiagnosisSettings = DiagnosisSettings(),
-                   progress: Callable[[str], None] | None = None) -> ModelFit:
-    """Fit the base model to the training logs (geometry from their sidecars)."""
+                   progress: Callable[[str], None] | None = None, fit_dynamics: bool | None = False) -> ModelFit:
+    """Fit the base model to the training logs (geometry from their sidecars).
+
+    fit_dynamics: also fit the damping time and inertia scale; None: when the logs are fast
+    (model.gap.calibration.is_fast).
+    """
     prior = prior_catheter(catheter_toml)
     recordings = load_recordings(train)
     say = progress or (lambda message: None)
+    if fit_dynamics is None:
+        fit_dynamics = is_fast(recordings)
+        say(f"fit: {100 * fast_travel_share(recordings):.0f}% of the tendon travel at >= "
+            f"{FAST_TENDON_SPEED_MM_S:g} mm/s: "
+            + ("fast, fitting the damping time and inertia scale too" if fit_dynamics else "quasi-static fit"))
     with ProcessPoolExecutor(settings.workers) if settings.workers > 1 else nullcontext() as pool:
         return calibrate_base(recordings, prior, resolution=settings.resolution,
                               max_iterations=settings.baseline_iterations, executor=pool,
-                              on_fit=lambda done, total: say(f"fit: {done}/{total} starts fitted"))
+                              on_fit=lambda done, total: say(f"fit: {done}/{total} starts fitted"),
+                              fit_dynamics=fit_dynamics)
 
 
 def diagnose_logs(train: Sequence[Path | str], holdout: Sequence[Path | str],

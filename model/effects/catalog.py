@@ -67,6 +67,14 @@ EFFECTS: dict[str, CandidateEffect] = {e.id: e for e in (
         lower=(-0.02, -0.02), upper=(0.02, 0.02),
         signature="a bend at zero load in a fixed plane, scaling with free length",
         apply=lambda t, v: t.replace(precurvature_per_mm=(v[0], v[1]))),
+    CandidateEffect(
+        id="rate_lag",
+        physics="viscoelastic drive line (standard linear solid): a creep stretch s with s + tau*ds/dt = c*T_drive, "
+                "so the catheter follows the drive with a first-order lag that grows with tension",
+        param_names=("compliance_mm_per_n", "time_s"), typical=(0.05, 0.3), lower=(0.0, 0.01), upper=(0.5, 5.0),
+        signature="the tip trails fast motion (error along the motion, growing with speed) and keeps creeping "
+                  "without overshoot for ~tau after each stop; slow motion and settled holds agree",
+        apply=lambda t, v: t.replace(drive_creep_mm_per_n=v[0], drive_creep_time_s=v[1])),
 )}
 
 

@@ -59,6 +59,12 @@ MIN_ITERATION_LIMIT = 1000
 EXPLORE_ITERATIONS = 3  # cost evaluations of each start's exploratory fit (`explore`)
 GRID_STARTS = 3         # the best points of `base_grid` (one model run each) that `calibrate_base` fits from
 ZERO_OFFSETS_MM = (0.0, 0.0, 0.0, 0.0)
+# Logs are fast when at least FAST_TRAVEL_SHARE of their tendon travel is made at FAST_TENDON_SPEED_MM_S or
+# more (the fastest tendon of each sample). Steps make all their travel in jumps (100 %), a 0.6 + 1.7 Hz
+# multisine with tendons at up to 9-20 mm/s (issue 16's catheter log) 38 %, the standard excitation 13-21 %.
+FAST_TENDON_SPEED_MM_S = 8.0
+FAST_TRAVEL_SHARE = 0.3
+DYNAMIC_START = (0.02, 1.0)   # damping time [s] and inertia scale a dynamic fit starts from
 
 
 @dataclass(frozen=True)
@@ -174,7 +180,7 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
               zero_offsets_mm: Sequence[float] = ZERO_OFFSETS_MM,
               effects: Mapping[str, Sequence[float]] | None = None, fit_base: bool = True,
               resolution: Resolution = Resolution(), max_iterations: int = 30,
-              restarts: int = MAX_RESTARTS) -> ModelFit:
+              restarts: int = MAX_RESTARTS, fit_dynamics: bool = False) -> ModelFit:
     """Fit the base parameters (unless fit_base is False) and the given effects' parameters.
 
     max_iterations bounds the cost evaluations of each least_squares run (not counting the
@@ -182,13 +188,14 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
     recordings: training recordings at full rate (decimated and capped here, Resolution.prepare_training).
     start: warm start; its geometry is replaced by the recordings'. prior: the catheter the
     physical ranges refer to (default: start). effects: {effect id: starting values}.
+    fit_dynamics: also fit the damping time and inertia scale (free_parameters.dynamic_parameters).
     Returns a new ModelFit; `start` is unchanged.
     """
     prepared = resolution.prepare_training(recordings)
     start = catheter_for(start, prepared)
     prior = catheter_for(prior or start, prepared)
     effects = {effect_id: tuple(values) for effect_id, values in (effects or {}).items()}
-    layout = ParameterLayout(prior, tuple(effects), fit_base)
+    layout = ParameterLayout(prior, tuple(effects), fit_base, fit_dynamics)
     zero_start = np.asarray(zero_offsets_mm, dtype=float)
     objective = _Objective(layout, start, zero_start, prepared, resolution,
                            iteration_limit(ModelFit(start, tuple(zero_start), effects), prepared, resolution))
@@ -246,23 +253,46 @@ def explore(recordings: Sequence[Recording], starts: Sequence[ModelFit], prior: 
 
 def calibrate_base(recordings: Sequence[Recording], prior: CatheterParams, *, resolution: Resolution = Resolution(),
                    max_iterations: int = 30, executor: Executor | None = None,
-                   on_fit: Callable[[int, int], None] | None = None) -> ModelFit:
+                   on_fit: Callable[[int, int], None] | None = None, fit_dynamics: bool = False) -> ModelFit:
     """The base model (no effects) fitted from each of `base_starts(prior)` and the GRID_STARTS best
     points of `base_grid(prior)` (see module doc): the fit with the lowest training RMSE.
 
     executor: runs the fits in parallel. on_fit(done, total) after each fit.
+    fit_dynamics: also fit the damping time and inertia scale (for fast logs, see `is_fast`); the
+    starts then begin at a 20 ms damping time and the catheter's own inertia, unless the prior has some.
     """
     prepared = resolution.prepare_training(recordings)
     grid = [ModelFit(params, ZERO_OFFSETS_MM, {}) for params in base_grid(catheter_for(prior, prepared))]
     costs = probe_costs(grid, prepared, resolution)
     starts = base_starts(prior) + [grid[i].params for i in np.argsort(costs, kind="stable")[:GRID_STARTS]]
-    fit_from = partial(calibrate, recordings, prior=prior, resolution=resolution, max_iterations=max_iterations)
+    if fit_dynamics and not prior.dynamic:
+        starts = [start.replace(damping_time_s=DYNAMIC_START[0], inertia_scale=DYNAMIC_START[1]) for start in starts]
+    fit_from = partial(calibrate, recordings, prior=prior, resolution=resolution, max_iterations=max_iterations,
+                       fit_dynamics=fit_dynamics)
     fits = []
     for fit in (executor.map(fit_from, starts) if executor is not None else map(fit_from, starts)):
         fits.append(fit)
         if on_fit is not None:
             on_fit(len(fits), len(starts))
     return min(fits, key=lambda fit: fit.train_rmse_mm)
+
+
+def fast_travel_share(recordings: Sequence[Recording]) -> float:
+    """The share of tendon travel made at FAST_TENDON_SPEED_MM_S or more.
+
+    Per sample, the fastest tendon's travel |du| and speed |du|/dt (finite differences of the logs);
+    the share is sum(|du| where fast) / sum(|du|), 0 for logs without motion.
+    """
+    travel = np.concatenate([np.abs(np.diff(r.tendon_mm, axis=0)).max(axis=1) for r in recordings])
+    speed = travel / np.concatenate([np.diff(r.t_s) for r in recordings])
+    total = float(travel.sum())
+    return float(travel[speed >= FAST_TENDON_SPEED_MM_S].sum()) / total if total > 0 else 0.0
+
+
+def is_fast(recordings: Sequence[Recording]) -> bool:
+    """Whether the logs' inputs are fast enough for the catheter's damping and mass to show (see
+    FAST_TRAVEL_SHARE): `crest fit` then fits the dynamic mode's parameters as well."""
+    return fast_travel_share(recordings) >= FAST_TRAVEL_SHARE
 
 
 def _statistics(jac: np.ndarray, fun: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:

@@ -102,6 +102,19 @@ def base_values(params: CatheterParams, zero_offsets_mm: Sequence[float]) -> dic
     return dict(zip(BASE_NAMES, (float(v) for v in values)))
 
 
+DYNAMIC_NAMES = ("damping_time_s", "inertia_scale")
+
+
+def dynamic_parameters() -> tuple[FreeParameter, ...]:
+    """The dynamic mode's damping time and inertia scale (CatheterParams [dynamics]), for fast logs.
+
+    Physical ranges: a polymer shaft's Kelvin-Voigt time eta/EI up to 0.5 s; an inertia from 0 to 5
+    times the catheter's own (a fluid-filled lumen, a sensor at the tip). Fit bounds 2 s and 20.
+    """
+    return (FreeParameter("damping_time_s", 0.0, 2.0, (0.0, 0.5), scale=0.02),
+            FreeParameter("inertia_scale", 0.0, 20.0, (0.0, 5.0), scale=1.0))
+
+
 def effect_parameters(effect_id: str) -> tuple[FreeParameter, ...]:
     """The candidate's parameters; its catalog range is both fit bound and physical range."""
     candidate = effect(effect_id)
@@ -111,15 +124,18 @@ def effect_parameters(effect_id: str) -> tuple[FreeParameter, ...]:
 
 @dataclass(frozen=True)
 class ParameterLayout:
-    """The vector least_squares sees: the base parameters (if fitted), then each effect's parameters."""
+    """The vector least_squares sees: the base parameters (if fitted), the dynamics (if fitted), then
+    each effect's parameters."""
 
     prior: CatheterParams
     effect_ids: tuple[str, ...]
     fit_base: bool = True
+    fit_dynamics: bool = False
 
     @property
     def parameters(self) -> tuple[FreeParameter, ...]:
         base = base_parameters(self.prior) if self.fit_base else ()
+        base += dynamic_parameters() if self.fit_dynamics else ()
         return base + tuple(p for effect_id in self.effect_ids for p in effect_parameters(effect_id))
 
     @property
@@ -134,6 +150,7 @@ class ParameterLayout:
                effects: Mapping[str, Sequence[float]]) -> np.ndarray:
         """Physical values in layout order."""
         base = list(base_values(params, zero_offsets_mm).values()) if self.fit_base else []
+        base += [getattr(params, name) for name in DYNAMIC_NAMES] if self.fit_dynamics else []
         return np.array(base + [float(v) for effect_id in self.effect_ids for v in effects[effect_id]])
 
     def pack(self, params: CatheterParams, zero_offsets_mm: Sequence[float],
@@ -155,6 +172,9 @@ class ParameterLayout:
                                     sigma_n_per_mm2=sigma, fsc_n_per_mm=max(fsc, 0.0))
             zero_offsets_mm = values[5:N_BASE]
             values = values[N_BASE:]
+        if self.fit_dynamics:
+            params = params.replace(**{name: max(v, 0.0) for name, v in zip(DYNAMIC_NAMES, values)})
+            values = values[len(DYNAMIC_NAMES):]
         effects = {}
         for effect_id in self.effect_ids:
             n = len(effect(effect_id).param_names)

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from model import CatheterParams, DahlCatheter, EffectTerms
+from model.dahl_catheter import MAX_DYNAMIC_SAMPLE_S
 from model.effects import combined_terms
 
 DEFAULT_PLANT_TOML = Path(__file__).resolve().parents[2] / "configs" / "virtual_plant.toml"
@@ -46,6 +47,7 @@ class PlantConfig:
             params = CatheterParams.from_toml(path.parent / raw.get("catheter", "catheter.toml"))
             params = params.replace(**{name: getattr(params, name) * _factor(name, factor)
                                        for name, factor in raw.get("mismatch", {}).items()})
+            params = params.replace(**_dynamics(raw.get("dynamics", {})))
             tracker = raw.get("tracker", {})
             zeros = tuple(float(v) for v in raw.get("tendon_zero_offsets_mm", (0.0, 0.0, 0.0, 0.0)))
             if len(zeros) != 4:
@@ -68,6 +70,20 @@ class PlantConfig:
         merged.update(effects)
         combined_terms(merged)
         return replace(self, effects=merged)
+
+
+DYNAMICS_KEYS = ("damping_time_s", "inertia_scale")
+
+
+def _dynamics(table) -> dict:
+    """The [dynamics] table: the catheter's dampers and masses (CatheterParams), replacing catheter.toml's."""
+    unknown = sorted(set(table) - set(DYNAMICS_KEYS))
+    if unknown:
+        raise ValueError(f"[dynamics] has unknown key(s) {unknown}; known: {list(DYNAMICS_KEYS)}")
+    for name, value in table.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ValueError(f"[dynamics].{name} must be a number, got {value!r}")
+    return {name: float(value) for name, value in table.items()}
 
 
 def _factor(name: str, value) -> float:
@@ -96,5 +112,7 @@ class DahlPlant:
         tendons = np.asarray(tendon_mm, dtype=float).reshape(1, 4) - np.asarray(self.config.tendon_zero_offsets_mm)
         params = self.config.params
         length_mm = min(max(float(insertion_mm), params.min_free_length_mm), params.max_free_length_mm)
-        tip = self.model.run(tendons, np.array([length_mm]), dt_s=max(float(dt_s), 1e-6))[0]
+        # a stalled bus can hand a long dt; the dynamic mode integrates at most MAX_DYNAMIC_SAMPLE_S of it
+        dt_s = min(max(float(dt_s), 1e-6), MAX_DYNAMIC_SAMPLE_S)
+        tip = self.model.run(tendons, np.array([length_mm]), dt_s=dt_s)[0]
         return tip, np.maximum(self.model.drive_tension_n, 0.0)
