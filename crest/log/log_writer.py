@@ -4,7 +4,7 @@ Durability: rows are collected in memory and written as whole lines, then ``os.f
 as the unwritten rows span ``flush_interval_s`` of log time (t) or that much wall time has passed
 since the last flush. A killed process therefore leaves a readable log that lacks at most the
 last flush interval (0.5 s by default). The sidecar is written at open (atomically) and rewritten
-at close with a ``summary``.
+at close with a ``summary`` (and again if the summary is amended after close).
 """
 
 from __future__ import annotations
@@ -178,6 +178,17 @@ class LogWriter:
                 "closed_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
                 **(summary or {}),
             }
+            _write_json_atomically(self.sidecar_path, self._sidecar)
+
+    def amend_summary(self, entries: Mapping[str, Any]) -> None:
+        """Add ``entries`` to the closed log's summary and rewrite the sidecar.
+
+        For what happens after the last row, e.g. a safety stop while the session is being closed.
+        """
+        with self._lock:
+            if self._fd is not None:
+                raise ValueError(f"{self.path}: the log is still open; pass the summary to close()")
+            self._sidecar["summary"].update(entries)
             _write_json_atomically(self.sidecar_path, self._sidecar)
 
     def __enter__(self) -> LogWriter:
