@@ -27,11 +27,14 @@ def crest_lines(stderr: str) -> list[str]:
     return [line for line in stderr.splitlines() if line.startswith("crest")]
 
 
-def start_recorded_run(log_path, *extra: str) -> subprocess.Popen:
-    """`crest run builtin:circle --record LOG` in real time, returned once rows are on disk."""
-    process = start_crest("run", "builtin:circle", "--periods", "20", "--record", str(log_path), *extra,
+def start_recorded_run(log_path) -> subprocess.Popen:
+    """A long `crest run builtin:circle --fast --record LOG`, returned once rows are on disk.
+
+    Simulated time (--fast): the drives count their heartbeat timeouts in it, so a loaded machine
+    cannot starve the run into a stop of its own."""
+    process = start_crest("run", "builtin:circle", "--periods", "100", "--fast", "--record", str(log_path),
                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    deadline = time.monotonic() + 120
+    deadline = time.monotonic() + 300
     while not log_path.exists() or log_path.read_bytes().count(b"\n") < 20:
         assert time.monotonic() < deadline and process.poll() is None, process.communicate()
         time.sleep(0.1)
