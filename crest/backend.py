@@ -72,14 +72,32 @@ def open_backend(config: TestbedConfig, *, plant: str | None = None, plant_confi
         if config.tracker.port == "sim":
             raise BackendError(f"{config.path}: [tracker].port = 'sim' needs the virtual testbed; "
                                "set it to the tracker's serial device")
-        try:
-            bus = can.Bus(interface=config.bus.interface, channel=config.bus.channel, bitrate=config.bus.bitrate)
-        except (can.CanError, OSError, ValueError, ImportError) as exc:
-            raise BackendError(f"cannot open CAN interface '{config.bus.interface}' channel "
-                               f"'{config.bus.channel}': {exc}. Check the adapter and [bus] in {config.path}") from exc
-        return Backend(bus=bus, tracker_port=config.tracker.port)
+        return Backend(bus=_open_hardware_bus(config), tracker_port=config.tracker.port)
     return _open_virtual(config, plant, plant_config, faults, effects or {}, realtime, plant_in_thread,
                          tracker_noise_mm, tracker_dropout)
+
+
+def join_bus(config: TestbedConfig) -> can.BusABC:
+    """A handle on the CAN bus of `config` for a process beside the master (``crest estop``).
+
+    Only a hardware bus can be joined: the drives of the virtual testbed live inside the crest
+    process that started them, on its in-process bus, and no other process can reach them. Opening
+    a virtual testbed here would boot drives of our own and reach nobody's, so it is refused
+    (BackendError). The tracker is not opened, so its [tracker].port does not matter.
+    """
+    if config.bus.interface == "virtual":
+        raise BackendError(f"the virtual testbed ({config.path}: [bus] interface = 'virtual') runs inside the "
+                           "crest process that started it; another process cannot reach its drives. "
+                           "Stop that run with Ctrl-C (or SIGTERM)")
+    return _open_hardware_bus(config)
+
+
+def _open_hardware_bus(config: TestbedConfig) -> can.BusABC:
+    try:
+        return can.Bus(interface=config.bus.interface, channel=config.bus.channel, bitrate=config.bus.bitrate)
+    except (can.CanError, OSError, ValueError, ImportError) as exc:
+        raise BackendError(f"cannot open CAN interface '{config.bus.interface}' channel "
+                           f"'{config.bus.channel}': {exc}. Check the adapter and [bus] in {config.path}") from exc
 
 
 def _open_virtual(config: TestbedConfig, plant_spec: str | None, plant_toml: Path | None, fault_texts: Sequence[str],

@@ -6,7 +6,8 @@ class ExitCode(IntEnum):
     OK = 0
     ERROR = 1              # bad input or an unexpected error; nothing moved or everything stopped
     USAGE = 2              # argparse's own code for bad command-line arguments
-    INTERRUPTED = 3        # Ctrl-C
+    INTERRUPTED = 3        # Ctrl-C (SIGINT)
+    TERMINATED = 4         # SIGTERM (e.g. `kill PID`, a supervisor or a service manager stopping crest)
     EMCY = 10              # a drive sent an emergency message
     HEARTBEAT_LOST = 11    # a drive's heartbeat stopped
     FOLLOWING_ERROR = 12   # an axis lagged beyond its following-error window

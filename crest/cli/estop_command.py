@@ -1,30 +1,52 @@
-"""`crest estop`: quick-stop every drive now, by SDO, from a second process."""
+"""`crest estop`: quick-stop every drive of a hardware testbed now, by SDO, from a second process.
+
+One line per axis on stdout. Success (exit 0) only when every axis answered and no longer shows
+OPERATION ENABLED; an axis that could not be reached or did not stop fails the command (exit 1)
+with one line on stderr naming the axes. On the virtual testbed there is nothing another process
+can reach, so estop refuses (exit 1) without opening anything.
+"""
 from __future__ import annotations
 
 import argparse
+import sys
+from pathlib import Path
 
-from crest.backend import open_backend
-from crest.cli.common_options import add_testbed_options
+from crest.backend import BackendError, join_bus
 from crest.config import load_testbed_config
-from crest.driver import emergency_stop
+from crest.driver import Cia402State, SdoFailure, emergency_stop
+from crest.exit_codes import ExitCode
 
 
 def add_parser(sub) -> None:
-    parser = sub.add_parser("estop", help="quick-stop every drive (works beside a running crest process)")
-    add_testbed_options(parser)
+    parser = sub.add_parser("estop", help="quick-stop every drive of a hardware testbed (beside a running crest)")
+    parser.add_argument("--config", type=Path, default=None,
+                        help="the testbed configuration of the running testbed (its [bus]; the tracker is not used)")
     parser.set_defaults(handler=run)
 
 
 def run(args: argparse.Namespace) -> int:
     config = load_testbed_config(args.config)
-    backend = open_backend(config)
     try:
-        results = emergency_stop(backend.bus, config)
+        bus = join_bus(config)
+    except BackendError as exc:
+        print(f"crest estop: nothing was stopped: {exc}", file=sys.stderr)
+        return int(ExitCode.ERROR)
+    try:
+        results = emergency_stop(bus, config)
     finally:
-        backend.close()
-    failed = False
+        bus.shutdown()
+    not_stopped = []
     for axis, result in results.items():
-        state = getattr(result, "name", str(result))
-        failed |= isinstance(result, Exception)
-        print(f"{axis:<10} {state}")
-    return 1 if failed else 0
+        if isinstance(result, SdoFailure):
+            print(f"{axis:<10} NOT REACHED: {str(result).removeprefix(f'{axis}: ')}")
+            not_stopped.append(axis)
+        elif result is Cia402State.OPERATION_ENABLED:
+            print(f"{axis:<10} NOT STOPPED: still OPERATION ENABLED after the quick stop")
+            not_stopped.append(axis)
+        else:
+            print(f"{axis:<10} stopped ({result.value})")
+    if not_stopped:
+        print(f"crest estop: {len(not_stopped)} of {len(results)} axes are not known to be stopped "
+              f"({', '.join(not_stopped)}); cut the drives' power", file=sys.stderr)
+        return int(ExitCode.ERROR)
+    return int(ExitCode.OK)

@@ -10,8 +10,9 @@ import sys
 
 from crest.cli import (bench_command, demo_command, estop_command, excite_command, fit_command, gap_command,
                        home_command, jog_command, move_command, paper_command, run_command, status_command)
+from crest.cli.library_logging import route_library_logging
 from crest.config import ConfigError
-from crest.driver import SafetyStop
+from crest.driver import SafetyStop, Terminated
 from crest.exit_codes import ExitCode
 
 COMMANDS = {
@@ -39,18 +40,31 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _raise_terminated(signum, frame) -> None:
+    """SIGTERM: stop like Ctrl-C. Later SIGTERMs are ignored, so a supervisor that repeats the
+    signal cannot break off the stop the first one started (SIGKILL still ends the process)."""
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    raise Terminated()
+
+
 def main(argv: list[str] | None = None) -> int:
     # A shell starts background commands with SIGINT ignored, and Python then never raises
     # KeyboardInterrupt. An interrupt (Ctrl-C, or `kill -INT` from a supervisor) must still stop
-    # every axis and save the log, however crest was started.
+    # every axis and save the log, however crest was started. SIGTERM (`kill PID`, a service
+    # manager) takes the same path with its own exit code.
     signal.signal(signal.SIGINT, signal.default_int_handler)
+    signal.signal(signal.SIGTERM, _raise_terminated)
     parser = build_parser()
     args = parser.parse_args(argv)
+    route_library_logging(args.debug)
     try:
         return int(args.handler(args))
     except SafetyStop as stop:
         print(f"crest: safety stop: {stop}", file=sys.stderr)
         return int(stop.exit_code)
+    except Terminated:
+        print("crest: stopped by SIGTERM", file=sys.stderr)
+        return int(ExitCode.TERMINATED)
     except KeyboardInterrupt:
         print("crest: stopped by Ctrl-C", file=sys.stderr)
         return int(ExitCode.INTERRUPTED)

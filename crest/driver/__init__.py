@@ -20,6 +20,7 @@ from crest.driver.errors import (
     SafetyStop,
     SdoFailure,
     StopCause,
+    Terminated,
 )
 from crest.driver.testbed import AxisStatus, BootReport, Testbed
 
@@ -44,6 +45,7 @@ __all__ = [
     "SdoFailure",
     "SteppedClock",
     "StopCause",
+    "Terminated",
     "Testbed",
     "emergency_stop",
 ]

@@ -54,6 +54,14 @@ class MotionRefused(DriveError):
     """A command outside the axis limits; refused before anything moved."""
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM arrived: stop exactly as for Ctrl-C, with its own exit code (TERMINATED).
+
+    A KeyboardInterrupt, so every place that turns Ctrl-C into a stop of every axis does the same
+    for SIGTERM; the CLI's signal handler raises it in the main thread.
+    """
+
+
 @dataclass(frozen=True)
 class StopCause:
     """Why the testbed stopped: the exit code, the axis (or ``bus``, ``tracker``, None) and the reason."""

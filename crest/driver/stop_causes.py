@@ -14,7 +14,7 @@ import math
 import can
 from canopen.emcy import EmcyError
 
-from crest.driver.errors import DriveError, StopCause
+from crest.driver.errors import DriveError, StopCause, Terminated
 from crest.exit_codes import ExitCode
 
 FOLLOWING_ERROR_CODE = 0x8611
@@ -88,6 +88,8 @@ def tracker_cause(age_s: float, limit_s: float) -> StopCause:
 
 def exception_cause(error: BaseException) -> StopCause:
     """The cause for an exception that ends a driver call or a ``with Testbed`` block."""
+    if isinstance(error, Terminated):
+        return StopCause(ExitCode.TERMINATED, None, "terminated (SIGTERM)")
     if isinstance(error, KeyboardInterrupt):
         return StopCause(ExitCode.INTERRUPTED, None, "interrupted (Ctrl-C)")
     if isinstance(error, DriveError):

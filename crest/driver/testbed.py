@@ -162,7 +162,7 @@ class Testbed:
                     self._monitor.armed = False
                     self._heartbeats.stop_watching()
                     for axis in self._axis_list:
-                        axis.sdo.write(CONSUMER_HEARTBEAT_TIME, 1, 0, "stop watching the host heartbeat")
+                        axis.sdo.write(CONSUMER_HEARTBEAT_TIME, 1, 0, "closing: stop watching the host heartbeat")
                         axis.node.nmt.send_command(NMT_ENTER_PRE_OPERATIONAL)
         finally:
             self._network.notifier.stop()

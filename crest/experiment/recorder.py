@@ -1,7 +1,8 @@
 """Recording one experiment: the crest log (CSV + sidecar) and the CAN traffic beside it.
 
 The log is closed with the stop cause when a safety stop happens, so a stopped run leaves a
-complete, readable log.
+complete, readable log. A stop after the log was closed (at the end of the session) still puts
+its cause into the sidecar.
 """
 from __future__ import annotations
 
@@ -66,4 +67,10 @@ class ExperimentRecorder:
             self._monitor.shutdown()
 
     def _on_safety_stop(self, stop: SafetyStop) -> None:
-        self.close({"stop_cause": str(stop), "exit_code": int(stop.exit_code)})
+        """The stop cause into the sidecar; a stop after the log was closed (while the session is
+        being closed, e.g. an SDO failure at the end) is added to its summary."""
+        cause = {"stop_cause": str(stop), "exit_code": int(stop.exit_code)}
+        if self.closed:
+            self.writer.amend_summary(cause)
+        else:
+            self.close(cause)

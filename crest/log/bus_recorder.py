@@ -13,6 +13,7 @@ every frame to every handle), or open the driver's bus with ``receive_own_messag
 from __future__ import annotations
 
 import threading
+import time
 import warnings
 from pathlib import Path
 from types import TracebackType
@@ -81,7 +82,9 @@ class BusRecorder(can.Listener):
         notifier, self._notifier = self._notifier, None
         if notifier is not None:
             if self._own_notifier:
+                notifier.remove_listener(self)   # its stop() would close the file before the drain
                 notifier.stop()
+                self._drain(notifier.bus)
             elif not notifier.stopped and self in notifier.listeners:
                 # A stopping notifier is iterating its listeners (calling our stop): leave its list alone.
                 notifier.remove_listener(self)
@@ -89,6 +92,13 @@ class BusRecorder(can.Listener):
             writer, self._writer = self._writer, None
             if writer is not None:
                 writer.stop()
+
+    def _drain(self, bus: can.BusABC) -> None:
+        """Record the frames ``bus`` received before now that the notifier's thread had not handed on
+        (e.g. the last frames of a safety stop, when the stop callback closes the recording)."""
+        now_s = time.time()   # python-can timestamps frames in time.time() seconds
+        while (msg := bus.recv(0)) is not None and msg.timestamp <= now_s:
+            self.on_message_received(msg)
 
     def __enter__(self) -> BusRecorder:
         return self

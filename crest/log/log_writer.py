@@ -4,7 +4,7 @@ Durability: rows are collected in memory and written as whole lines, then ``os.f
 as the unwritten rows span ``flush_interval_s`` of log time (t) or that much wall time has passed
 since the last flush. A killed process therefore leaves a readable log that lacks at most the
 last flush interval (0.5 s by default). The sidecar is written at open (atomically) and rewritten
-at close with a ``summary``.
+at close with a ``summary`` (and again if the summary is amended after close).
 """
 
 from __future__ import annotations
@@ -107,9 +107,10 @@ class LogWriter:
         check_sidecar(self._sidecar, self.sidecar_path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         _write_json_atomically(self.sidecar_path, self._sidecar)
-        flags = os.O_WRONLY | os.O_CREAT | os.O_APPEND | (os.O_TRUNC if overwrite else os.O_EXCL)
+        flags = os.O_WRONLY | os.O_CREAT | (os.O_TRUNC if overwrite else os.O_EXCL)
         self._fd: int | None = os.open(self.path, flags, 0o644)
-        self._write_and_sync(",".join(self.columns) + "\n")
+        self._size_bytes = 0
+        self._size_bytes = self._write_and_sync(",".join(self.columns) + "\n")
 
     @property
     def rows_written(self) -> int:
@@ -180,6 +181,17 @@ class LogWriter:
             }
             _write_json_atomically(self.sidecar_path, self._sidecar)
 
+    def amend_summary(self, entries: Mapping[str, Any]) -> None:
+        """Add ``entries`` to the closed log's summary and rewrite the sidecar.
+
+        For what happens after the last row, e.g. a safety stop while the session is being closed.
+        """
+        with self._lock:
+            if self._fd is not None:
+                raise ValueError(f"{self.path}: the log is still open; pass the summary to close()")
+            self._sidecar["summary"].update(entries)
+            _write_json_atomically(self.sidecar_path, self._sidecar)
+
     def __enter__(self) -> LogWriter:
         return self
 
@@ -189,17 +201,27 @@ class LogWriter:
 
     def _flush_locked(self) -> None:
         if self._pending:
-            self._write_and_sync("".join(self._pending))
-            self._pending.clear()
+            end_bytes = self._write_and_sync("".join(self._pending))
+            # No call between these two stores, so Ctrl-C or SIGTERM (whose exception Python
+            # raises at a call or a loop) cannot count the rows as written but leave them pending.
+            self._size_bytes, self._pending = end_bytes, []
             self._flushed_t_s = self._last_t_s
         self._flushed_at = self._clock()
 
-    def _write_and_sync(self, text: str) -> None:
+    def _write_and_sync(self, text: str) -> int:
+        """Write ``text`` after the bytes already counted as written, fsync; returns the new end.
+
+        At an explicit offset, not appended: when Ctrl-C or SIGTERM interrupts a flush after the
+        bytes reached the file but before they were counted, the next flush (the stop closing the
+        log) writes them again at the same place, instead of a second time after them.
+        """
         data = text.encode("ascii")
+        offset = self._size_bytes
         while data:
-            written = os.write(self._fd, data)
-            data = data[written:]
+            written = os.pwrite(self._fd, data, offset)
+            data, offset = data[written:], offset + written
         os.fsync(self._fd)
+        return offset
 
 
 def _number(value: float) -> str:

@@ -11,10 +11,10 @@ import math
 import can
 import pytest
 
-from crest.driver import SafetyStop, emergency_stop
+from crest.driver import SafetyStop, SdoFailure, emergency_stop
 from crest.driver.cia402 import Cia402State
 from crest.exit_codes import ExitCode
-from driver_rig import STOPPED_STATES, is_sync, rpdo1, tpdo1
+from driver_rig import STOPPED_STATES, is_sync, make_config, rpdo1, tpdo1
 from sim_backend.faults import FaultKind, parse_fault
 
 QUICK_STOP = 0x0002
@@ -194,7 +194,9 @@ def test_an_exception_in_a_with_block_stops_every_axis(homed, error, exit_code):
     assert_all_stopped(homed)
 
 
-def test_crest_estop_from_another_process_stops_every_axis(homed):
+def test_emergency_stop_over_a_second_bus_handle_stops_every_axis(homed):
+    """In one process: emergency_stop() on a second handle of the rig's bus, as `crest estop` uses
+    it on a hardware bus. The command itself, from another process, is tested in tests/cli."""
     homed.testbed.jog_to(homed.testbed.targets_from_pulls(5.0, 0.0, 40.0))
     for _ in range(10):
         homed.testbed.cycle()
@@ -208,6 +210,23 @@ def test_crest_estop_from_another_process_stops_every_axis(homed):
         homed.testbed.cycle()
     assert stop.value.exit_code == ExitCode.ERROR and "left OPERATION ENABLED" in str(stop.value)
     assert_all_stopped(homed)
+
+
+def test_emergency_stop_tries_every_axis_and_reports_the_one_it_could_not_reach(make_rig):
+    rig = make_rig(config=make_config(sdo_timeout_s=0.2))   # the timeout is expected to expire
+    rig.testbed.boot()
+    rig.drive("tendon3").inject_fault(FaultKind.SDO_TIMEOUT)
+    other_bus = can.Bus(interface="virtual", channel=rig.channel)
+    try:
+        outcome = emergency_stop(other_bus, rig.config)
+    finally:
+        other_bus.shutdown()
+    assert list(outcome) == ["tendon1", "tendon2", "tendon3", "tendon4", "insertion"]
+    assert isinstance(outcome.pop("tendon3"), SdoFailure)
+    assert set(outcome.values()) <= {Cia402State.QUICK_STOP_ACTIVE, Cia402State.SWITCH_ON_DISABLED}
+    with pytest.raises(SafetyStop) as stop:        # closing needs tendon3's SDO server too
+        rig.testbed.close()
+    assert (stop.value.exit_code, stop.value.axis) == (ExitCode.SDO_FAILURE, "tendon3")
 
 
 def test_a_dead_host_stops_the_testbed(homed):

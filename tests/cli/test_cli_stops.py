@@ -1,0 +1,138 @@
+"""Stops that really stop, through the CLI: estop from a second process, SIGTERM, an SDO failure.
+
+Each command runs as the operator runs it, in a process of its own (cli_runner). The stop is
+read back from what the run leaves behind: exit code, its one line, the log, the sidecar's stop
+cause and the CAN recording beside the log.
+"""
+import json
+import signal
+import struct
+import subprocess
+import time
+
+import can
+
+from cli_runner import crest, start_crest
+from crest.config import default_config_path
+from crest.driver.cia402 import ENERGISED_STATES, QUICK_STOP, state_from_statusword
+from crest.exit_codes import ExitCode
+from crest.log import read_log
+
+NODE_IDS = (1, 2, 3, 4, 5)          # configs/testbed.toml, tendon1..tendon4, insertion
+AXES = ("tendon1", "tendon2", "tendon3", "tendon4", "insertion")
+LIBRARY_LINES = ("Transfer aborted", "canopen", "Traceback")
+
+
+def crest_lines(stderr: str) -> list[str]:
+    return [line for line in stderr.splitlines() if line.startswith("crest")]
+
+
+def start_recorded_run(log_path) -> subprocess.Popen:
+    """A long `crest run builtin:circle --fast --record LOG`, returned once rows are on disk.
+
+    Simulated time (--fast): the drives count their heartbeat timeouts in it, so a loaded machine
+    cannot starve the run into a stop of its own."""
+    process = start_crest("run", "builtin:circle", "--periods", "100", "--fast", "--record", str(log_path),
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 300
+    while not log_path.exists() or log_path.read_bytes().count(b"\n") < 20:
+        assert time.monotonic() < deadline and process.poll() is None, process.communicate()
+        time.sleep(0.1)
+    return process
+
+
+def rows_on_disk(log_path) -> int:
+    return log_path.read_bytes().count(b"\n") - 1
+
+
+def real_bus_config(tmp_path):
+    """configs/testbed.toml on a python-can bus that opens without hardware or network and has no
+    drives on it (a serial loopback: every frame comes back to its sender, no drive answers),
+    with [tracker].port still 'sim'."""
+    text = default_config_path().read_text()
+    text = text.replace('interface = "virtual"', 'interface = "serial"').replace('channel = "crest"',
+                                                                               'channel = "loop://"')
+    assert 'interface = "serial"' in text and 'port = "sim"' in text
+    path = tmp_path / "testbed.toml"
+    path.write_text(text)
+    (tmp_path / "crest_drive.eds").write_text((default_config_path().parent / "crest_drive.eds").read_text())
+    return path
+
+
+def test_estop_on_the_virtual_testbed_from_another_process_refuses_and_reaches_nothing(tmp_path):
+    log_path = tmp_path / "run.csv"
+    run = start_recorded_run(log_path)
+    try:
+        estop = crest("estop")
+        assert estop.returncode == ExitCode.ERROR, estop.stderr
+        assert estop.stdout == ""                              # no axis was opened, booted or stopped
+        lines = crest_lines(estop.stderr)
+        assert len(lines) == 1 and "Traceback" not in estop.stderr
+        assert "another process cannot reach its drives" in lines[0] and "Ctrl-C" in lines[0]
+        # The run beside it goes on as before: still running, still writing rows.
+        rows = rows_on_disk(log_path)
+        deadline = time.monotonic() + 60
+        while rows_on_disk(log_path) < rows + 20:
+            assert time.monotonic() < deadline and run.poll() is None, run.communicate()
+            time.sleep(0.1)
+        run.send_signal(signal.SIGINT)
+        _, stderr = run.communicate(timeout=60)
+        assert run.returncode == ExitCode.INTERRUPTED, stderr     # stopped by us, not by the estop
+    finally:
+        if run.poll() is None:
+            run.kill()
+            run.communicate()
+
+
+def test_estop_with_a_real_bus_ignores_the_tracker_and_fails_for_every_axis_it_cannot_reach(tmp_path):
+    result = crest("estop", "--config", str(real_bus_config(tmp_path)))
+    assert result.returncode == ExitCode.ERROR, result.stderr
+    assert "tracker" not in result.stderr                     # [tracker].port = 'sim' is no reason to refuse
+    rows = result.stdout.splitlines()
+    assert [row.split()[0] for row in rows] == list(AXES)
+    assert all("NOT REACHED" in row and "no answer" in row for row in rows)
+    lines = crest_lines(result.stderr)
+    assert len(lines) == 1 and "5 of 5 axes" in lines[0]
+    assert not any(text in result.stderr + result.stdout for text in LIBRARY_LINES)
+
+
+def test_library_log_records_show_with_debug_only(tmp_path):
+    result = crest("--debug", "estop", "--config", str(real_bus_config(tmp_path)))
+    assert result.returncode == ExitCode.ERROR
+    assert "canopen" in result.stderr and "Transfer aborted by client with code 0x05040000" in result.stderr
+
+
+def test_sigterm_stops_every_axis_saves_the_log_and_names_sigterm(tmp_path):
+    log_path = tmp_path / "run.csv"
+    run = start_recorded_run(log_path)
+    run.send_signal(signal.SIGTERM)
+    stdout, stderr = run.communicate(timeout=60)
+    assert run.returncode == ExitCode.TERMINATED, stderr
+    lines = crest_lines(stderr)
+    assert len(lines) == 1 and "SIGTERM" in lines[0] and "Traceback" not in stderr
+    sidecar = json.loads(log_path.with_suffix(".json").read_text())
+    assert "SIGTERM" in sidecar["summary"]["stop_cause"]
+    assert sidecar["summary"]["exit_code"] == ExitCode.TERMINATED
+    assert len(read_log(log_path)) >= 20
+    # The CAN recording: every drive got the quick stop, and its last answer shows it stopped.
+    frames = list(can.LogReader(log_path.with_suffix(".blf")))
+    for node in NODE_IDS:
+        controlwords = [struct.unpack("<Hi", bytes(f.data))[0] for f in frames if f.arbitration_id == 0x200 + node]
+        statuswords = [struct.unpack("<Hih", bytes(f.data))[0] for f in frames if f.arbitration_id == 0x180 + node]
+        assert QUICK_STOP in controlwords, f"node {node}"
+        assert state_from_statusword(statuswords[-1]) not in ENERGISED_STATES, f"node {node}"
+
+
+def test_a_drive_that_stops_answering_sdo_ends_in_an_sdo_safety_stop_with_its_cause_saved(tmp_path):
+    """The drive's SDO server dies at 1 s while its process data go on: the run needs no SDO and
+    completes; closing the session does, and fails. The axes are stopped, the cause is saved."""
+    log_path = tmp_path / "run.csv"
+    result = crest("run", "builtin:sweep", "--fast", "--fault", "tendon2:sdo_timeout@1", "--record", str(log_path))
+    assert result.returncode == ExitCode.SDO_FAILURE, result.stderr
+    lines = crest_lines(result.stderr)
+    assert len(lines) == 1 and "tendon2" in lines[0] and "SDO" in lines[0]
+    assert not any(text in result.stderr + result.stdout for text in LIBRARY_LINES)
+    sidecar = json.loads(log_path.with_suffix(".json").read_text())
+    assert "tendon2" in sidecar["summary"]["stop_cause"] and "SDO" in sidecar["summary"]["stop_cause"]
+    assert sidecar["summary"]["exit_code"] == ExitCode.SDO_FAILURE
+    assert len(read_log(log_path)) == sidecar["summary"]["samples"] > 50
