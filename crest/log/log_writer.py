@@ -3,7 +3,9 @@
 Durability: rows are collected in memory and written as whole lines, then ``os.fsync``-ed, as soon
 as the unwritten rows span ``flush_interval_s`` of log time (t) or that much wall time has passed
 since the last flush. A killed process therefore leaves a readable log that lacks at most the
-last flush interval (0.5 s by default). The sidecar is written at open (atomically) and rewritten
+last flush interval (0.5 s by default). An interrupt (Ctrl-C raises KeyboardInterrupt between any
+two bytecodes, also in the middle of a flush) never makes a row appear twice: a flush appends only
+the bytes that the file's size shows are not in it yet. The sidecar is written at open (atomically) and rewritten
 at close with a ``summary``.
 """
 
@@ -87,7 +89,8 @@ class LogWriter:
         self._flush_interval_s = flush_interval_s
         self._clock = clock
         self._lock = threading.Lock()
-        self._pending: list[str] = []
+        self._unwritten = b""            # accepted rows (whole lines) not yet known to be in the file
+        self._unwritten_at_b = 0         # the file offset they go to
         self._rows_written = 0
         self._first_t_s: float | None = None
         self._last_t_s: float | None = None
@@ -111,7 +114,8 @@ class LogWriter:
         _write_json_atomically(self.sidecar_path, self._sidecar)
         flags = os.O_WRONLY | os.O_CREAT | os.O_APPEND | (os.O_TRUNC if overwrite else os.O_EXCL)
         self._fd: int | None = os.open(self.path, flags, 0o644)
-        self._write_and_sync(",".join(self.columns) + "\n")
+        self._unwritten = (",".join(self.columns) + "\n").encode("ascii")
+        self._append_unwritten()
 
     @property
     def rows_written(self) -> int:
@@ -151,7 +155,7 @@ class LogWriter:
             if self._first_t_s is None:
                 self._first_t_s = self._flushed_t_s = t_s
             self._last_t_s = t_s
-            self._pending.append(",".join(cells) + "\n")
+            self._unwritten += (",".join(cells) + "\n").encode("ascii")
             self._rows_written += 1
             if (t_s - self._flushed_t_s >= self._flush_interval_s
                     or self._clock() - self._flushed_at >= self._flush_interval_s):
@@ -190,18 +194,21 @@ class LogWriter:
         self.close(None if exc is None else {"stop_cause": f"{type(exc).__name__}: {exc}"})
 
     def _flush_locked(self) -> None:
-        if self._pending:
-            self._write_and_sync("".join(self._pending))
-            self._pending.clear()
+        if self._unwritten:
+            self._append_unwritten()
             self._flushed_t_s = self._last_t_s
         self._flushed_at = self._clock()
 
-    def _write_and_sync(self, text: str) -> None:
-        data = text.encode("ascii")
-        while data:
-            written = os.write(self._fd, data)
-            data = data[written:]
+    def _append_unwritten(self) -> None:
+        """Append the unwritten rows and fsync them. The part already in the file (a write that an
+        interrupt cut short of its bookkeeping) is found from the file's size and not written again."""
+        while True:
+            in_file_b = os.fstat(self._fd).st_size - self._unwritten_at_b
+            if in_file_b >= len(self._unwritten):
+                break
+            os.write(self._fd, self._unwritten[in_file_b:])
         os.fsync(self._fd)
+        self._unwritten, self._unwritten_at_b = b"", self._unwritten_at_b + len(self._unwritten)
 
 
 def _number(value: float) -> str:
