@@ -55,8 +55,9 @@ def run(args: argparse.Namespace) -> int:
             recorder.close({"rms_tip_error_mm": result.rms_tip_error_mm})
             results[name] = result
     for name, result in results.items():
+        lost = result.tip_coverage.loss_sentence()
         print(f"{name:>5}: RMS tip error {result.rms_tip_error_mm:.2f} mm over {result.tip_samples} tracker "
-              f"samples; log {result.log_path}")
+              f"samples" + (f"; {lost}" if lost else "") + f"; log {result.log_path}")
     cc, dahl = results["cc"].rms_tip_error_mm, results["dahl"].rms_tip_error_mm
     print(f"the friction-aware feedforward cuts the tip error by {100 * (1 - dahl / cc):.0f}% "
           "against constant curvature")

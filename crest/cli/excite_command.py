@@ -39,7 +39,9 @@ def run(args: argparse.Namespace) -> int:
     with open_session(session_options(args)) as session:
         results = record_excitation(session, plan, args.record, params, on_cycle)
     for name, result in results.items():
-        print(f"wrote {result.log_path} ({result.cycles} cycles, tip seen in {result.tip_samples})")
+        lost = result.tip_coverage.loss_sentence()
+        print(f"wrote {result.log_path} ({result.cycles} cycles, a tip in {result.tip_samples}"
+              + (f"; {lost}" if lost else "") + ")")
     train, holdout = results["train"].log_path, results["holdout"].log_path
     print(f"next: crest gap {train} --holdout {holdout} --json gap.json --report gap_report")
     return 0

@@ -205,9 +205,9 @@ def run(args: argparse.Namespace) -> int:
                     governor.speed_scale = scale
                     testbed.jog_to(state.targets(), speed_fraction=JOG_SPEED_FRACTION * scale)
                 sample = testbed.cycle()
-                feed.poll(sample.t_s)
+                measurement = feed.poll(sample.t_s)
                 if recorder:
-                    recorder.write(sample, feed.latest_tip_mm)
+                    recorder.write(sample, None if measurement is None else measurement.tip_mm)
                 cycles += 1
                 governor.notice_cycles = max(0, governor.notice_cycles - 1)
                 if cycles % STATUS_EVERY_CYCLES == 0:

@@ -16,6 +16,7 @@ from crest.experiment.controlled_run import run_with_controller
 from crest.experiment.planned_tension import check_planned_tension
 from crest.experiment.recorder import ExperimentRecorder
 from crest.experiment.setpoint_csv import read_setpoints
+from crest.experiment.tip_coverage import TipCoverage
 from crest.session import open_session
 
 
@@ -83,14 +84,16 @@ def _run_csv(args, config) -> int:
         session.testbed.home()
         recorder = _recorder(session, args, params, f"set-points {args.trajectory}", tip_ref=False)
         progress = ProgressBar(len(samples), args.trajectory)
-        done = [0]
+        feed = session.tip_feed()
+        coverage = TipCoverage(config.tracker.loss_timeout_s if session.tracker is not None else None)
 
         def on_sample(sample):
-            done[0] += 1
-            tip = session.tracker.latest() if session.tracker else None
+            measurement = feed.poll(sample.t_s)
+            tip = None if measurement is None else measurement.tip_mm
             if recorder:
-                recorder.write(sample, tip.tip_mm if tip is not None else None)
-            progress.update(done[0])
+                recorder.write(sample, tip)
+            coverage.add(sample.t_s, tip is not None)
+            progress.update(coverage.rows)
 
         try:
             session.testbed.run_trajectory(samples, on_sample=on_sample)
@@ -99,7 +102,9 @@ def _run_csv(args, config) -> int:
             progress.close()
         if recorder:
             recorder.close()
-    print(f"ran {len(samples)} set-points" + (f"; log: {recorder.path}" if recorder else ""))
+    parts = [f"ran {len(samples)} set-points", coverage.loss_sentence(),
+             f"log: {recorder.path}" if recorder else None]
+    print("; ".join(part for part in parts if part))
     return 0
 
 
@@ -109,6 +114,9 @@ def _recorder(session, args, params, source, tip_ref=True):
 
 
 def _report(result) -> None:
-    rms = "no tip samples" if result.rms_tip_error_mm is None else f"RMS tip error {result.rms_tip_error_mm:.2f} mm"
-    print(f"ran {result.cycles} cycles; {rms}" + (f"; log: {result.log_path}" if result.log_path else ""),
-          file=sys.stdout)
+    """One line: cycles, the tracker loss if any, the tip error over the cycles with a tip, the log."""
+    rms = ("no tip samples" if result.rms_tip_error_mm is None
+           else f"RMS tip error {result.rms_tip_error_mm:.2f} mm over {result.tip_samples} tracker samples")
+    parts = [f"ran {result.cycles} cycles", result.tip_coverage.loss_sentence(), rms,
+             f"log: {result.log_path}" if result.log_path else None]
+    print("; ".join(part for part in parts if part), file=sys.stdout)

@@ -52,7 +52,8 @@ def record_excitation(session: Session, plan: ExcitationPlan, folder: Path, para
     folder/<name>.csv.
 
     on_cycle(name, done, total) is called after every cycle of every run (the conditioning's as
-    "<name> conditioning"). Returns each log's result (cycles, cycles with a tip, log path).
+    "<name> conditioning"). Returns each log's result (cycles, cycles with a tip, tracker loss, log path);
+    each log's summary holds its rows with and without a tip and the tracker loss, if any.
     """
     session.testbed.home()
     results = {}
@@ -61,7 +62,7 @@ def record_excitation(session: Session, plan: ExcitationPlan, folder: Path, para
         recorder = ExperimentRecorder(session, Path(folder) / f"{name}.csv", params, source=f"crest excite: {name}",
                                       notes=NOTES)
         results[name] = _run(session, trajectory, recorder, name, on_cycle)
-        recorder.close({"tip_samples": results[name].tip_samples})
+        recorder.close()
     return results
 
 

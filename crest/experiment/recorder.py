@@ -1,8 +1,10 @@
 """Recording one experiment: the crest log (CSV + sidecar) and the CAN traffic beside it.
 
-The log is closed with the stop cause when a safety stop happens, so a stopped run leaves a
-complete, readable log. A stop after the log was closed (at the end of the session) still puts
-its cause into the sidecar.
+A row's tip is the tip of a tracker frame that arrived since the row before, or empty (see
+tip_feed). The log is closed with the stop cause when a safety stop happens, so a stopped run
+leaves a complete, readable log; every close adds the tip coverage (rows with and without a tip,
+when the tracker was lost: tip_coverage) to the sidecar's summary. A stop after the log was
+closed (at the end of the session) still puts its cause into the sidecar.
 """
 from __future__ import annotations
 
@@ -12,6 +14,7 @@ import numpy as np
 
 from crest import __version__
 from crest.driver import CycleSample, SafetyStop
+from crest.experiment.tip_coverage import TipCoverage
 from crest.log import BusRecorder, LogWriter
 from crest.log.log_format import catheter_dict
 from crest.session import Session
@@ -42,6 +45,7 @@ class ExperimentRecorder:
         else:
             self._monitor = None
             session.testbed.add_listener(self.bus)
+        self.tip_coverage = TipCoverage(config.tracker.loss_timeout_s if session.tracker is not None else None)
         session.testbed.on_safety_stop(self._on_safety_stop)
         self._t0_s: float | None = None
         self.closed = False
@@ -51,17 +55,20 @@ class ExperimentRecorder:
         return self.writer.path
 
     def write(self, sample: CycleSample, tip_mm: np.ndarray | None, tip_ref_mm: np.ndarray | None = None) -> None:
+        """One row: the cycle's measurements and tip_mm, the tip of a tracker frame new since the
+        last row (None when no new frame with the tool in view arrived: an empty tip)."""
         if self._t0_s is None:
             self._t0_s = sample.t_s
         self.writer.write(sample.t_s - self._t0_s, sample.tendon_target_mm, sample.insertion_target_mm,
                           sample.tendon_position_mm, sample.insertion_position_mm, tip_mm,
                           tendon_force_n=sample.tendon_tension_n, tip_ref_mm=tip_ref_mm)
+        self.tip_coverage.add(sample.t_s, tip_mm is not None and bool(np.isfinite(tip_mm).all()))
 
     def close(self, summary: dict | None = None) -> None:
         if self.closed:
             return
         self.closed = True
-        self.writer.close(summary or {})
+        self.writer.close({**self.tip_coverage.summary(), **(summary or {})})
         self.bus.close()
         if self._monitor is not None:
             self._monitor.shutdown()

@@ -175,7 +175,7 @@ def record_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Exci
                                     timeout_s=RECORD_TIMEOUT_S)
         except (PlantFailure, CallTimedOut):
             continue
-        if all(r.tip_samples >= MIN_TIP_FRACTION_BEYOND_DROPOUT * (1.0 - case.tracker_dropout) * r.cycles
+        if all(r.tip_samples >= MIN_TIP_FRACTION_BEYOND_DROPOUT * (1.0 - case.tracker_dropout) * r.tracker_frames
                for r in results.values()):
             return case, results["train"].log_path, results["holdout"].log_path
     raise PlantFailure(f"blind case {case.index}: the plant failed in {MAX_REDRAWS + 1} draws")

@@ -14,7 +14,9 @@ Conventions:
 - insertion is the free length extended from the tube.
 - The tip is in the base frame: origin at the centre of the tube exit, z out of the tube,
   x toward tendon 1.
-- A missing tracker sample is an empty cell (tip_x, tip_y, tip_z all empty). Empty cells are
+- A missing tracker sample is an empty cell (tip_x, tip_y, tip_z all empty). A row's tip comes
+  from a tracker frame that arrived since the row before: a log written faster than the tracker
+  has empty tips between frames, never the previous frame again. Empty cells are
   allowed only in the tip, tip_ref and tendon_force columns; t, commands and positions are always
   finite numbers. Numbers are plain decimals (``nan``/``inf`` text is refused).
 - The writer writes whole lines; a last line without its ``\\n`` is the partial write of a killed
@@ -25,8 +27,11 @@ JSON sidecar: same stem, suffix ``.json``:
      "catheter": {"flexible_length_mm": >0, "outer_diameter_mm": >0 or null,
                   "tendon_offset_mm": >0, "tendon_angles_deg": [4 numbers]},
      "sample_rate_hz": >0, "source": "...", "notes": "..."}
-Further keys are allowed (the writer adds ``config``, ``software``, ``created_utc``, ``columns``
-and, at close, ``summary``).
+Further keys are allowed (the writer adds ``config``, ``software``, ``created_utc``, ``columns``,
+``units`` and, at close, ``summary``). ``units`` maps each column of the header to its unit
+(COLUMN_UNITS: "s", "mm" or "N"), e.g. ``{"t": "s", "tendon_cmd_1": "mm", "tendon_force_1": "N"}``;
+it is optional (older logs lack it), and when present every entry must name a known column with
+the unit this format fixes for it.
 """
 
 from __future__ import annotations
@@ -53,6 +58,12 @@ OPTIONAL_COLUMN_GROUPS = {"tendon_force": TENDON_FORCE_COLUMNS, "tip_ref": TIP_R
 # Columns that must hold a finite number on every row; the others may be empty (missing).
 FINITE_COLUMNS = ((TIME_COLUMN,) + TENDON_CMD_COLUMNS + (INSERTION_CMD_COLUMN,) + TENDON_POS_COLUMNS
                   + (INSERTION_POS_COLUMN,))
+
+COLUMN_UNITS = {TIME_COLUMN: "s",
+                **{name: "mm" for name in TENDON_CMD_COLUMNS + (INSERTION_CMD_COLUMN,) + TENDON_POS_COLUMNS
+                   + (INSERTION_POS_COLUMN,) + TIP_COLUMNS + TIP_REF_COLUMNS},
+                **{name: "N" for name in TENDON_FORCE_COLUMNS}}
+"""The unit of every column this format knows (the sidecar's ``units`` lists those of its header)."""
 
 TENDON_ANGLES_DEG = (0.0, 90.0, 180.0, 270.0)
 
@@ -129,12 +140,32 @@ def check_sidecar(sidecar: Any, path: Path) -> dict[str, Any]:
         raise LogFormatError(path, "catheter.outer_diameter_mm is missing; give it in mm or null when unknown")
     if catheter["outer_diameter_mm"] is not None:
         _check_positive(catheter["outer_diameter_mm"], path, "catheter.outer_diameter_mm")
+    if "units" in sidecar:
+        _check_units(sidecar["units"], path)
     angles = catheter.get("tendon_angles_deg")
     if (not isinstance(angles, list) or len(angles) != 4
             or not all(_is_number(angle) and math.isfinite(angle) for angle in angles)):
         raise LogFormatError(path, f"catheter.tendon_angles_deg must be a list of 4 numbers such as "
                                    f"[0, 90, 180, 270], got {angles!r}")
     return sidecar
+
+
+def units_of(columns: Sequence[str]) -> dict[str, str]:
+    """The sidecar's ``units``: each column's unit, in header order."""
+    return {name: COLUMN_UNITS[name] for name in columns}
+
+
+def _check_units(units: Any, path: Path) -> None:
+    """Refuse a ``units`` entry that is not a known column with this format's unit for it."""
+    if not isinstance(units, dict):
+        raise LogFormatError(path, f"'units' must be a JSON object mapping columns to units, got {units!r}")
+    for name, unit in units.items():
+        if name not in COLUMN_UNITS:
+            raise LogFormatError(path, f"units names {name!r}, which is not a {FORMAT_TAG} column")
+        if unit != COLUMN_UNITS[name]:
+            raise LogFormatError(path, f"units.{name} is {unit!r}, but {FORMAT_TAG} stores {name} in "
+                                       f"{COLUMN_UNITS[name]!r}: convert the column and write "
+                                       f"{COLUMN_UNITS[name]!r}")
 
 
 def _is_number(value: Any) -> bool:

@@ -40,7 +40,8 @@ class ExperimentLog:
 
     ``tip_mm`` is NaN on rows where the tracker sample is missing; ``tendon_force_n`` and
     ``tip_ref_mm`` are None when the log has no such columns (NaN where a cell is empty).
-    ``sidecar`` is the whole JSON sidecar (config snapshot, software version, summary, ...).
+    ``sidecar`` is the whole JSON sidecar (units per column, config snapshot, software version,
+    summary, ...).
     """
 
     path: Path

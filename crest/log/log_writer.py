@@ -32,6 +32,7 @@ from crest.log.log_format import (
     check_sidecar,
     header_columns,
     sidecar_path,
+    units_of,
 )
 
 DEFAULT_FLUSH_INTERVAL_S = 0.5
@@ -100,6 +101,7 @@ class LogWriter:
             "source": source,
             "notes": notes,
             "columns": list(self.columns),
+            "units": units_of(self.columns),
             "created_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
             "software": {"crest_version": software_version(), "python": platform.python_version()},
             "config": None if config is None else dict(config),

@@ -5,6 +5,7 @@ import select
 import subprocess
 import time
 
+import numpy as np
 import pytest
 
 from cli_runner import CREST, REPO
@@ -51,6 +52,8 @@ def test_jog_moves_pitch_and_insertion_and_releases_on_quit(tmp_path):
     log = read_log(tmp_path / "jog.csv")
     assert log.tendon_cmd_mm[-1, 0] > log.tendon_cmd_mm[-1, 2]     # tendon 1 pulled, tendon 3 paid out
     assert log.insertion_cmd_mm[-1] > log.insertion_cmd_mm[0]
+    tips = log.tip_mm[log.tip_valid]          # 40 Hz tracker frames in 100 Hz rows: each frame in one row
+    assert 0 < len(tips) <= log.t_s[-1] * 40.0 + 1 and not np.all(tips[1:] == tips[:-1], axis=1).any()
 
 
 def test_jog_pulling_one_tendon_pays_out_its_partner_and_stops_short_of_the_tension_limit(tmp_path):
