@@ -16,7 +16,7 @@ ROWS = 20
 
 def _interrupt_once(monkeypatch, name: str) -> None:
     """The next os.<name> call is interrupted: the first half of its bytes reach the file
-    (os.write) or the whole call completes (os.fsync), then KeyboardInterrupt."""
+    (os.pwrite) or the whole call completes (os.fsync), then KeyboardInterrupt."""
     real = getattr(os, name)
     armed = [True]
 
@@ -24,8 +24,8 @@ def _interrupt_once(monkeypatch, name: str) -> None:
         if not armed[0]:
             return real(fd, *data)
         armed[0] = False
-        if name == "write":
-            real(fd, data[0][: len(data[0]) // 2])
+        if name == "pwrite":
+            real(fd, data[0][: len(data[0]) // 2], data[1])
         else:
             real(fd)
         raise KeyboardInterrupt
@@ -33,7 +33,7 @@ def _interrupt_once(monkeypatch, name: str) -> None:
     monkeypatch.setattr(os, name, interrupted)
 
 
-@pytest.mark.parametrize("call", ["write", "fsync"])
+@pytest.mark.parametrize("call", ["pwrite", "fsync"])
 def test_an_interrupt_during_a_flush_leaves_every_row_once(tmp_path: Path, monkeypatch, call: str):
     path = tmp_path / "run.csv"
     writer = LogWriter(path, catheter=CATHETER, sample_rate_hz=100.0, source="interrupted flush")

@@ -97,30 +97,6 @@ def test_a_stop_after_close_is_added_to_the_summary(tmp_path: Path):
     assert len(read_log(path)) == 1
 
 
-def test_ctrl_c_or_sigterm_during_a_flush_neither_repeats_nor_loses_rows(tmp_path: Path, monkeypatch):
-    """The signal's exception is raised between two Python steps, here once the rows are written
-    but before their fsync returned; the stop then closes the log, which flushes again."""
-    import crest.log.log_writer as log_writer
-    path = tmp_path / "interrupted.csv"
-    writer = _open(path)
-    real_fsync = log_writer.os.fsync
-    interrupted = []
-
-    def fsync_interrupted_once(fd: int) -> None:
-        real_fsync(fd)
-        if not interrupted:
-            interrupted.append(fd)
-            raise KeyboardInterrupt
-
-    monkeypatch.setattr(log_writer.os, "fsync", fsync_interrupted_once)
-    with pytest.raises(KeyboardInterrupt):
-        for k in range(100):
-            writer.write(0.01 * k, [0] * 4, 50, [0] * 4, 50)
-    writer.close({"stop_cause": "interrupted"})
-    assert interrupted
-    assert len(read_log(path)) == writer.rows_written == 51     # t = 0 .. 0.5 s reached the flush
-
-
 def test_writer_refuses_what_the_reader_would_reject(tmp_path: Path):
     with _open(tmp_path / "bad.csv") as writer:
         with pytest.raises(ValueError, match="tendon_cmd_3 must be a finite number"):
