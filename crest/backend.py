@@ -59,8 +59,8 @@ def open_backend(config: TestbedConfig, *, plant: str | None = None, plant_confi
                  tracker_dropout: float | None = None) -> Backend:
     """Open the bus and tracker of `config`.
 
-    plant ('package.module:ClassName'), plant_config (the default plant's description, default
-    configs/virtual_plant.toml), faults ('AXIS:KIND@SECONDS'), effects ({effect id: {param: value}},
+    plant ('package.module:ClassName'), plant_config (the plant description, default
+    configs/virtual_plant.toml; its `family` picks the Dahl or the rod plant), faults ('AXIS:KIND@SECONDS'), effects ({effect id: {param: value}},
     added to the plant description's) and the tracker's noise and dropout apply to the virtual
     testbed only. realtime=False leaves time to the caller's `Backend.tick` (tests).
     """
@@ -86,22 +86,22 @@ def _open_virtual(config: TestbedConfig, plant_spec: str | None, plant_toml: Pat
                   effects: dict, realtime: bool, plant_in_thread: bool, tracker_noise_mm: float | None,
                   tracker_dropout: float | None) -> Backend:
     from sim_backend.faults import parse_fault
-    from sim_backend.plant import DahlPlant, PlantConfig, load_plant
-    from sim_backend.plant.dahl_plant import DEFAULT_PLANT_TOML
+    from sim_backend.plant import load_plant
+    from sim_backend.plant.plant_description import load_plant_description
     from sim_backend.virtual_testbed import TrackerSettings, VirtualTestbed
 
     faults = [parse_fault(text) for text in fault_texts]
-    plant_config = PlantConfig.from_toml(plant_toml or DEFAULT_PLANT_TOML).with_effects(effects)
-    plant = load_plant(plant_spec) if plant_spec else DahlPlant(plant_config)
+    described_plant, tracker = load_plant_description(plant_toml, effects)
+    plant = load_plant(plant_spec) if plant_spec else described_plant
     specs = [_drive_spec(config, axis) for axis in config.axes]
     # The virtual bus is in-process: a channel of our own per testbed keeps testbeds apart.
     channel = f"{config.bus.channel}-{os.getpid()}-{next(_channel_numbers)}"
     testbed = VirtualTestbed(specs, channel, plant, bitrate_bit_s=config.bus.bitrate,
                              sync_period_s=config.sync.period_s, faults=faults,
                              tracker=TrackerSettings(
-                                 plant_config.tracker_noise_mm if tracker_noise_mm is None else tracker_noise_mm,
-                                 plant_config.tracker_dropout if tracker_dropout is None else tracker_dropout,
-                                 plant_config.tracker_seed, int(config.tracker.tool_port, 16)),
+                                 tracker.noise_mm if tracker_noise_mm is None else tracker_noise_mm,
+                                 tracker.dropout if tracker_dropout is None else tracker_dropout,
+                                 tracker.seed, int(config.tracker.tool_port, 16)),
                              plant_in_thread=plant_in_thread)
     testbed.start(realtime=realtime)
     bus = can.Bus(interface="virtual", channel=channel, receive_own_messages=False)
@@ -125,3 +125,20 @@ def _drive_spec(config: TestbedConfig, axis: AxisConfig):
         start_position_mm=axis.home_position_mm + INSERTION_START_ABOVE_HOME_MM if is_insertion else 0.0,
         master_node_id=config.master.node_id, heartbeat_period_s=config.master.drive_heartbeat_period_s,
         heartbeat_timeout_s=config.master.heartbeat_timeout_s, cycle_period_s=config.sync.period_s)
+
+
+def plant_effect_ranges(family: str) -> dict:
+    """The effects a plant family implements and the ranges to draw their parameters from:
+    {effect id: {"in_catalog": bool, "physics": str, "params": {name: {"low", "typical", "high",
+    "draw", "allowed"}}}}; draw is "log", "log_signed" or "uniform". family: "dahl" or "rod"."""
+    from sim_backend.plant.plant_description import plant_effect_ranges as ranges
+
+    return ranges(family)
+
+
+def plant_from_description(plant_toml: Path | None, effects: dict | None = None):
+    """The plant a plant TOML describes (for benchmarks): has reset() and
+    step(dt_s, tendon_mm[4], insertion_mm) -> (tip_mm[3], tendon_tension_n[4])."""
+    from sim_backend.plant.plant_description import load_plant_description
+
+    return load_plant_description(plant_toml, effects)[0]

@@ -1,0 +1,167 @@
+"""The rod plant: a Kirchhoff-rod catheter with frictional elastic tendons, behind the drives.
+
+Each step (quasi-static, step_solver.py does the rod and tendons):
+
+1. Drive train. The catheter base sees the pull x_k = the drive position minus the tendon's
+   zero offset, through the drum's play if `backlash` is on (x follows u only once u leaves
+   [x - w/2, x + w/2]).
+2. Free length. The nodes cover the free length L out of the support tube, M nodes evenly.
+   Material enters and leaves at the tube exit: state fixed to the material (tension memory,
+   creep) is kept as a function of the distance from the tip and re-sampled on the new grid
+   when L changes; material just emerging from the tube takes the base node's state (inside the
+   straight tube the tendons neither bend nor wrap). With `tube_friction` the free length follows
+   the insertion axis only once the shaft force exceeds the grip: L moves to stay within
+   +-F_grip / k_shaft of the axis.
+3. Solve for the drive tensions (Newton) with the friction return mapping from the last profile.
+4. Creep (sheath_creep): the rest curvature relaxes toward f (kappa - kappa_set),
+   kappa_c += (f (kappa - kappa_set) - kappa_c) (1 - exp(-dt / tau)).
+5. The tip: the last node, plus the sensor's mount offset turned by the tip frame (tracker_offset).
+
+Output: (tip_mm (3,), tension at the drives (4,)), the plant protocol of plant_protocol.py.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from sim_backend.plant.rod.rod_description import RodDescription
+from sim_backend.plant.rod.step_solver import solve_step
+
+MIN_FREE_LENGTH_MM = 1.0
+TOLERANCE_MM = 1e-7        # compatibility residual of each tendon at the solution
+MAX_ITERATIONS = 60
+
+
+class RodSolverError(RuntimeError):
+    """The step did not converge; the message gives the inputs it was solving for."""
+
+
+class RodPlant:
+    """A continuum-rod catheter. No-argument construction reads configs/rod_plant.toml."""
+
+    def __init__(self, description: RodDescription | None = None):
+        self.description = description if description is not None else RodDescription.from_toml()
+        d = self.description
+        self._ei_nmm2 = d.bending_stiffness_nmm2
+        self._zeros_mm = np.asarray(d.tendon_zero_offsets_mm, dtype=float)
+        fx = d.effects
+        self._drive_compliance = d.drive_compliance_mm_per_n + fx.get("tendon_elasticity", {}).get(
+            "extra_compliance_mm_per_n", 0.0)
+        self._play_mm = fx.get("backlash", {}).get("gear_play_mm", 0.0)
+        tube = fx.get("tube_friction")
+        self._tube_play_mm = tube["grip_friction_n"] / tube["shaft_stiffness_n_per_mm"] if tube else 0.0
+        sensor = fx.get("tracker_offset", {})
+        self._sensor_mm = np.array([sensor.get("sensor_x_mm", 0.0), sensor.get("sensor_y_mm", 0.0),
+                                    sensor.get("sensor_z_mm", 0.0)])
+        self._mu_rate = fx.get("rate_friction", {}).get("mu_rate_s_per_mm", 0.0)
+        creep = fx.get("sheath_creep", {})
+        self._creep_fraction = creep.get("creep_fraction", 0.0)
+        self._creep_tau_s = creep.get("time_constant_s", 1.0)
+        self.reset()
+
+    # -- state ----------------------------------------------------------------------------------
+    def reset(self) -> None:
+        m = self.description.grid_nodes
+        self.free_length_mm: float | None = None
+        self.pull_mm = np.zeros(4)                 # at the catheter base, after the drive train
+        self.tension_n = np.zeros((m, 4))          # tendon tension profiles, node 0 = tube exit
+        self.creep_per_mm = np.zeros((m, 2))       # crept rest curvature (sheath_creep)
+        self.drive_tension_n = np.zeros(4)
+        self.kappa_per_mm = np.zeros((m, 2))
+        self.rotation = np.tile(np.eye(3), (m, 1, 1))
+        self.position_mm = np.zeros((m, 3))
+        self.iterations = 0
+        self._nodes_length_mm: float | None = None     # the free length the node properties were built for
+        self._node_cache: dict = {}
+
+    # -- the plant protocol ---------------------------------------------------------------------
+    def step(self, dt_s: float, tendon_mm, insertion_mm: float) -> tuple[np.ndarray, np.ndarray]:
+        """Advance to the drives' positions; returns (tip_mm (3,), tendon tension at the drives (4,))."""
+        dt_s = max(float(dt_s), 0.0)
+        u = np.asarray(tendon_mm, dtype=float).reshape(4) - self._zeros_mm
+        half = 0.5 * self._play_mm
+        pull = np.clip(self.pull_mm, u - half, u + half) if self.free_length_mm is not None else u.copy()
+        speed_mm_s = np.abs(pull - self.pull_mm) / dt_s if dt_s > 0 else np.zeros(4)
+        self._move_free_length(float(insertion_mm))
+        if self._nodes_length_mm != self.free_length_mm:
+            self._node_cache = self._nodes()
+            self._nodes_length_mm = self.free_length_mm
+        nodes = self._node_cache
+        mu = self.description.mu * (1.0 + self._mu_rate * speed_mm_s)
+        kappa_rest = nodes["kappa_set"] + self.creep_per_mm
+        tension = np.empty_like(self.tension_n)
+        drive = self.drive_tension_n.copy()
+        iterations = solve_step(nodes["h_mm"], nodes["ei"], nodes["r"], nodes["cos_phi"], nodes["sin_phi"], nodes["ea_axial"],
+                                kappa_rest,
+                                nodes["kappa_set"], nodes["weight"], self._drive_compliance,
+                                self.description.tendon_axial_stiffness_n, mu, self.description.friction_n_per_mm,
+                                pull, self.tension_n, drive, tension, self.kappa_per_mm, self.rotation,
+                                self.position_mm, TOLERANCE_MM, MAX_ITERATIONS)
+        if iterations < 0:
+            raise RodSolverError(f"rod plant: no tendon-tension solution within {MAX_ITERATIONS} Newton iterations "
+                                 f"at pull {np.round(pull, 4)} mm, free length {self.free_length_mm:.2f} mm")
+        self.iterations = iterations
+        self.tension_n = tension
+        self.drive_tension_n = drive
+        self.pull_mm = pull
+        if self._creep_fraction > 0.0 and dt_s > 0.0:
+            relax = 1.0 - math.exp(-dt_s / self._creep_tau_s)
+            self.creep_per_mm += (self._creep_fraction * (self.kappa_per_mm - nodes["kappa_set"])
+                                  - self.creep_per_mm) * relax
+        tip = self.position_mm[-1] + self.rotation[-1] @ self._sensor_mm
+        return tip, drive.copy()
+
+    # -- free length and the grid ---------------------------------------------------------------
+    def _move_free_length(self, insertion_mm: float) -> None:
+        target = max(insertion_mm, MIN_FREE_LENGTH_MM)
+        if self.free_length_mm is None:
+            self.free_length_mm = target
+            return
+        old = self.free_length_mm
+        new = float(np.clip(old, target - self._tube_play_mm, target + self._tube_play_mm))
+        new = max(new, MIN_FREE_LENGTH_MM)
+        if new == old:
+            return
+        m = self.description.grid_nodes
+        # distance from the tip, increasing: reversed node order
+        from_tip_old = old - np.linspace(0.0, old, m)[::-1]
+        from_tip_new = new - np.linspace(0.0, new, m)[::-1]
+        for name in ("tension_n", "creep_per_mm"):
+            values = getattr(self, name)[::-1]
+            resampled = np.column_stack([np.interp(from_tip_new, from_tip_old, values[:, c])
+                                         for c in range(values.shape[1])])
+            setattr(self, name, np.ascontiguousarray(resampled[::-1]))
+        self.free_length_mm = new
+
+    def _nodes(self) -> dict:
+        """Per-node properties over the current free length (s from the tube exit, sigma from the tip)."""
+        fx = self.description.effects
+        m = self.description.grid_nodes
+        length = self.free_length_mm
+        s = np.linspace(0.0, length, m)
+        from_tip = length - s
+        h = length / (m - 1)
+        ei = np.full(m, self._ei_nmm2)
+        if "stiffness_step" in fx:
+            step = fx["stiffness_step"]
+            ei[from_tip <= step["distance_from_tip_mm"]] *= step["stiffness_ratio"]
+        r = self.description.tendon_offset_mm + fx.get("lumen_offset_drift", {}).get("tip_offset_change_mm", 0.0) * s / length
+        helix = fx.get("torsion", {}).get("helix_rad_per_mm", 0.0)
+        phi = np.arange(4) * (np.pi / 2) + helix * s[:, None]
+        ea_axial = np.full(m, self.description.axial_stiffness_n)
+        if "lumen_compression" in fx:
+            soft = fx["lumen_compression"]
+            ea_axial[s <= soft["soft_length_mm"]] = soft["soft_axial_stiffness_n"]
+        pre = fx.get("precurvature", {})
+        kappa_set = np.tile([pre.get("rest_kappa_x_per_mm", 0.0), pre.get("rest_kappa_y_per_mm", 0.0)], (m, 1))
+        weight = np.zeros((m, 3))
+        if "gravity" in fx:
+            g = fx["gravity"]
+            direction = np.deg2rad(g["direction_deg"])
+            lumped = np.full(m, h)
+            lumped[[0, -1]] = 0.5 * h
+            weight[:, 0] = g["load_n_per_mm"] * lumped * np.cos(direction)
+            weight[:, 1] = g["load_n_per_mm"] * lumped * np.sin(direction)
+        return {"h_mm": h, "ei": ei, "r": r, "cos_phi": np.cos(phi), "sin_phi": np.sin(phi), "ea_axial": ea_axial,
+                "kappa_set": kappa_set, "weight": weight}
