@@ -49,6 +49,7 @@ from pathlib import Path
 
 import numpy as np
 
+from crest.backend import plant_effect_ranges
 from crest.config import TestbedConfig, load_testbed_config
 from crest.driver import SafetyStop
 from crest.experiment.excitation_run import ExcitationPlan, plan_excitation, record_excitation
@@ -123,7 +124,6 @@ def effect_ranges(family: str) -> dict[str, dict]:
     if family == "dahl":
         return DAHL_EFFECT_RANGES
     if family == "rod":
-        from crest.backend import plant_effect_ranges
         return plant_effect_ranges("rod")
     raise ValueError(f"unknown plant family {family!r}; families: {', '.join(FAMILIES)} (or both)")
 
