@@ -66,3 +66,21 @@ def test_detection_curve_bins_top1_by_effect_size_relative_to_the_baseline_resid
         {"ratio_low": 0.0, "ratio_high": 0.1, "cases": 2, "top1": 0.5},
         {"ratio_low": 0.7, "ratio_high": 1.0, "cases": 1, "top1": 1.0}]
     assert result["top1_single_above_detection"] == 1.0 and result["counts"]["single_above_detection"] == 1
+
+
+def test_rod_draw_holds_clean_single_and_out_of_catalog_cases_in_the_rods_own_terms(tmp_path):
+    from crest.backend import plant_effect_ranges, plant_from_description
+    from crest.gap.blind_benchmark import write_plant_config
+
+    cases = draw_cases(20, seed=3, prior=CatheterParams.from_toml(), family="rod")
+    kinds = [c.kind for c in cases]
+    assert kinds.count("none") == 4 and kinds.count("out_of_catalog") == 4 and kinds.count("pair") == 0
+    ranges = plant_effect_ranges("rod")
+    assert {c.effects[0] for c in cases if c.kind == "out_of_catalog"} <= {
+        e for e, spec in ranges.items() if not spec["in_catalog"]}
+    for case in cases:
+        for effect_id, params in case.plant.effects.items():     # inside the drawing range, by name
+            for name, value in params.items():
+                spec = ranges[effect_id]["params"][name]
+                assert spec["low"] <= abs(value) <= spec["high"] or spec["draw"] == "uniform"
+        plant_from_description(write_plant_config(case, tmp_path / f"case_{case.index}"))   # the plant accepts it
