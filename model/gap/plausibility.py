@@ -4,7 +4,10 @@ Two checks, each giving a reason when it fails (a fit that passes both has no re
 
 1. Range: every effect parameter inside its physical range (model.effects.catalog) and not at
    a bound other than 0 (within 1 % of the range width): a fit pushed to the limit wanted more
-   than the effect can be, i.e. it absorbs something else.
+   than the effect can be, i.e. it absorbs something else. Lumen compression acts near the base:
+   its extent may reach NEAR_BASE_FRACTION of the catheter's flexible length, no further (a
+   compression along the whole catheter is a different moment arm or stiffness, i.e. model form:
+   on the rod plant without effects a fit with extent 181 mm took 48 % of the residual).
 2. Signature: with the per-sample gain g_t = |e_before,t|^2 - |e_after,t|^2 (mm^2) on the
    selection half, the gain's concentration in the effect's signature region R,
 
@@ -34,6 +37,7 @@ MIN_REGION_SAMPLES = 10
 ZERO_LOAD_DEG = 15.0
 HIGH_ARTICULATION_DEG = 45.0
 FAST_MM_S = 2.0
+NEAR_BASE_FRACTION = 0.5
 
 
 def signature_region(name: str, features: SampleFeatures) -> np.ndarray:
@@ -52,10 +56,15 @@ def signature_region(name: str, features: SampleFeatures) -> np.ndarray:
     return masks[name]()
 
 
-def range_reasons(effect_id: str, values: tuple[float, ...]) -> list[str]:
-    """Why the effect's fitted values are implausible (empty: plausible)."""
+def range_reasons(effect_id: str, values: tuple[float, ...], flexible_length_mm: float | None = None) -> list[str]:
+    """Why the effect's fitted values are implausible (empty: plausible); flexible_length_mm: the
+    catheter's, for the effects whose range depends on it (None: not checked)."""
     candidate = effect(effect_id)
     reasons = []
+    if effect_id == "lumen_compression" and flexible_length_mm is not None \
+            and values[1] > NEAR_BASE_FRACTION * flexible_length_mm:
+        reasons.append(f"lumen_compression.extent_mm = {values[1]:.4g} reaches beyond {NEAR_BASE_FRACTION:g} of the "
+                       f"flexible length ({flexible_length_mm:g} mm): a compression near the base does not")
     for name, value, low, high in zip(candidate.param_names, values, candidate.lower, candidate.upper):
         if not low <= value <= high:
             reasons.append(f"{effect_id}.{name} = {value:.4g} is outside its physical range [{low:g}, {high:g}]")

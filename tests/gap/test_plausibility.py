@@ -32,3 +32,9 @@ def test_gravity_that_only_improves_bent_samples_does_not_match_its_signature():
     after_everywhere = 0.5 * before
     reasons, concentration = signature_reasons("gravity", f, before, after_everywhere)
     assert reasons == [] and concentration >= MIN_SIGNATURE_CONCENTRATION
+
+
+def test_lumen_compression_along_the_whole_catheter_is_not_near_the_base():
+    assert range_reasons("lumen_compression", (0.03, 20.0), flexible_length_mm=100.0) == []
+    reasons = range_reasons("lumen_compression", (0.01, 181.0), flexible_length_mm=100.0)
+    assert len(reasons) == 1 and "flexible length" in reasons[0]
