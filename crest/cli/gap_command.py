@@ -16,6 +16,7 @@ from crest.gap.log_recordings import load_recordings
 from crest.reports.blind_report import write_blind_report
 from crest.reports.gap_report import write_gap_report
 from model.gap.diagnosis import DiagnosisSettings
+from model.gap.finite_json import finite_tree
 
 
 def add_parser(sub) -> None:
@@ -30,6 +31,8 @@ def add_parser(sub) -> None:
                         help="validate instead on virtual-testbed logs whose effect is withheld")
     parser.add_argument("--cases", type=int, default=40, help="blind benchmark: number of cases (default 40)")
     parser.add_argument("--seed", type=int, default=0, help="blind benchmark: random seed")
+    parser.add_argument("--family", choices=("dahl", "rod", "both"), default="dahl",
+                        help="blind benchmark: the plant family (default dahl; both: --cases of each)")
     parser.add_argument("--short", action="store_true", help="blind benchmark: the short excitation (faster)")
     parser.add_argument("--work-dir", type=Path, default=None,
                         help="blind benchmark: keep each case's plant and logs here (default: a temporary folder)")
@@ -45,12 +48,12 @@ def run(args: argparse.Namespace) -> int:
     if args.blind_benchmark:
         if args.train or args.holdout:
             raise ValueError("--blind-benchmark makes its own logs; do not pass training or held-out logs")
-        result = run_blind_benchmark(args.cases, args.seed, short=args.short, settings=settings,
+        result = run_blind_benchmark(args.cases, args.seed, family=args.family, short=args.short, settings=settings,
                                      work_dir=args.work_dir, progress=_progress)
         _write_json(result, args.json_path)
         if args.report:
             print(f"report written to {write_blind_report(result, args.report)}")
-        print(format_score(result["score"]))
+        print("\n".join(format_family_score(family, score) for family, score in result["score"].items()))
         return 0
     if not args.train or not args.holdout:
         raise ValueError("give training logs and --holdout logs (recorded on other trajectories), "
@@ -65,8 +68,13 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _write_json(result: dict, path: Path | None) -> None:
+    """Strict JSON: every number finite; a non-finite one is written as null and listed with its
+    reason under "non_finite" (`finite_tree`)."""
     if path:
-        path.write_text(json.dumps(result, indent=2))
+        tree, nulls = finite_tree(result)
+        if nulls:
+            tree["non_finite"] = list(tree.get("non_finite") or []) + nulls
+        path.write_text(json.dumps(tree, indent=2, allow_nan=False))
         print(f"results written to {path}")
 
 
@@ -77,8 +85,13 @@ def format_verdict(result: dict) -> str:
              "gap concentrates in: " + (", ".join(result["concentrated"][:5]) or "no region"),
              f"verdict: {verdict['effect']}" + (f" ({' + '.join(verdict['effects'])})" if len(verdict["effects"]) > 1
                                                 else ""),
-             f"held-out {verdict['holdout_rmse_before_mm']:.3f} -> {verdict['holdout_rmse_after_mm']:.3f} mm, "
-             f"shrink {100 * verdict['shrink']:.1f} %"]
+             f"held-out (report half) {verdict['holdout_rmse_before_mm']:.3f} -> "
+             f"{verdict['holdout_rmse_after_mm']:.3f} mm, shrink {100 * verdict['shrink']:.1f} % "
+             f"(selected on the other half: {verdict['shrink_estimate']['method']})"]
+    if verdict["model_form_rms_mm"] is not None and not verdict["effects"]:
+        lines.append(f"residual above the noise floor (model form): {verdict['model_form_rms_mm']:.3f} mm RMS")
+    for row in verdict["rejected"]:
+        lines.append(f"not {row['effect']}: " + "; ".join(row["reasons"]))
     return "\n".join(lines + [f"  {line}" for line in verdict["residual"]])
 
 
@@ -96,3 +109,21 @@ def format_score(score: dict) -> str:
         f"pairs: exact {pct(score['pair_exact'])}, at least one found {pct(score['pair_any_found'])}",
         f"shrink error vs oracle: mean {shrink.get('mean', float('nan')):.1f} pp (target <= 10 pp), median "
         f"{shrink.get('median', float('nan')):.1f} pp, within 10 pp in {pct(shrink.get('within_10pp'))} of cases"])
+
+
+def format_family_score(family: str, score: dict) -> str:
+    """The family's heading, `format_score`, and the scores the issue-14 benchmark adds."""
+    def pct(value: float | None) -> str:
+        return "-" if value is None else f"{100 * value:.0f} %"
+
+    counts = score["counts"]
+    lines = [f"== {family} family ==", format_score(score),
+             f"top-1 above the detection limit ({counts['single_above_detection']} cases): "
+             f"{pct(score['top1_single_above_detection'])} (target >= 90 %)",
+             f"clean cases with no catalog effect named ('none' or 'unexplained'): "
+             f"{pct(score['no_catalog_effect_clean'])} (target >= 80 %)"]
+    if counts["out_of_catalog"]:
+        lines.append(f"out-of-catalog cases 'unexplained': {pct(score['unexplained_out_of_catalog'])} "
+                     f"(target >= 80 %); a catalog effect named in {score['catalog_effect_out_of_catalog']} of "
+                     f"{counts['out_of_catalog']}")
+    return "\n".join(lines)

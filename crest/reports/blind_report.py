@@ -1,9 +1,12 @@
 """The blind-benchmark report: Markdown and PNG (`crest gap --blind-benchmark --report DIR`).
 
-- blind_benchmark.md: the scores against their targets, the confusion matrix (true effect ->
-  verdict, single and clean cases), and one line per case;
-- confusion.png: the confusion matrix as a heat map;
-- shrink.png: the predicted shrink against the oracle shrink, one point per case.
+- blind_benchmark.md: per plant family the scores against their targets, the confusion matrix
+  (true effect -> verdict: single, clean and out-of-catalog cases), the detection-limit table,
+  and one line per case;
+- confusion_<family>.png: the confusion matrix as a heat map;
+- detection_<family>.png: top-1 per effect against the effect's size relative to the baseline
+  residual (the detection-limit curve);
+- shrink.png: the predicted shrink against the oracle shrink, one point per case with an effect.
 """
 from __future__ import annotations
 
@@ -19,7 +22,9 @@ def write_blind_report(result: dict, out_dir: Path | str) -> Path:
     """Write blind_benchmark.md and the figures into out_dir (created); returns the Markdown path."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    save_png(_confusion_figure(result["score"]["confusion"]), out / "confusion.png")
+    for family, score in result["score"].items():
+        save_png(_confusion_figure(score["confusion"]), out / f"confusion_{family}.png")
+        save_png(_detection_figure(score["detection_curve"]), out / f"detection_{family}.png")
     save_png(_shrink_figure(result["cases"]), out / "shrink.png")
     path = out / "blind_benchmark.md"
     path.write_text(markdown(result))
@@ -48,35 +53,80 @@ def _pct(value: float | None) -> str:
 
 
 def markdown(result: dict) -> str:
-    score, settings = result["score"], result["settings"]
+    settings = result["settings"]
+    lines = ["# Blind benchmark of the gap diagnosis", "",
+             f"Seed {settings['seed']}, {settings['excitation']} excitation, {settings['path']}; "
+             f"{settings['seconds'] / 60:.0f} min.", ""]
+    for family, score in result["score"].items():
+        lines += _family_markdown(family, score)
+    lines += ["## Cases", "",
+              "| family | case | truth | verdict | effect size mm | size / residual | noise mm | shrink | oracle |",
+              "|---|---|---|---|---|---|---|---|---|"]
+    for row in result["cases"]:
+        truth = "+".join(row["truth"]) or "none"
+        family = row.get("family", "dahl")
+        if "predicted_shrink" not in row:
+            lines.append(f"| {family} | {row['case']} | {truth} | {row.get('skipped') or row.get('no_result')} "
+                         "| | | | | |")
+            continue
+        oracle = f"{row['oracle_shrink']:.2f}" if row.get("oracle_shrink") is not None else "-"
+        lines.append(f"| {family} | {row['case']} | {truth} | {'+'.join(row['predicted_effects']) or row['predicted']} | "
+                     f"{row['effect_rms_mm']:.2f} | {row.get('relative_size', 0.0):.2f} | {row['noise_mm']:.2f} | "
+                     f"{row['predicted_shrink']:.2f} | {oracle} |")
+    return "\n".join(lines) + "\n"
+
+
+def _family_markdown(family: str, score: dict) -> list[str]:
     shrink = score["shrink_error_pp"] or {}
     counts = score["counts"]
     lines = [
-        "# Blind benchmark of the gap diagnosis", "",
-        f"{score['cases']} cases, seed {settings['seed']}, {settings['excitation']} excitation, "
-        f"{settings['path']}; {settings['seconds'] / 60:.0f} min.", "",
+        f"## {family} family: {score['cases']} cases", "",
         "| score | result | target |", "|---|---|---|",
-        f"| top-1 on single effects | {_pct(score['top1_single'])} of {counts['single']} | >= 90% |",
+        f"| top-1 on single effects | {_pct(score['top1_single'])} of {counts['single']} | - |",
+        f"| top-1 above the detection limit | {_pct(score['top1_single_above_detection'])} of "
+        f"{counts['single_above_detection']} | >= 90% |",
         f"| top-1 where the effect moves the tip more than the tracker noise | "
         f"{_pct(score['top1_single_above_noise'])} of {counts['single'] - counts['single_below_noise']} | - |",
-        f"| `none` on clean cases | {_pct(score['none_clean'])} of {counts['none']} | >= 80% |",
-        f"| pairs: exact / at least one found | {_pct(score['pair_exact'])} / {_pct(score['pair_any_found'])} "
-        f"of {counts['pair']} | - |",
-        f"| predicted shrink vs oracle, mean error | {shrink.get('mean', float('nan')):.1f} pp "
-        f"(median {shrink.get('median', float('nan')):.1f}, max {shrink.get('max', float('nan')):.1f}) | <= 10 pp |",
-        "", f"Skipped (no plant could be recorded): {counts['skipped']}; no result: {counts['no_result']}.", "",
-        "## Confusion matrix (single and clean cases)", "", confusion_markdown(score["confusion"]), "",
-        "## Cases", "",
-        "| case | truth | verdict | effect size mm | noise mm | shrink | oracle |", "|---|---|---|---|---|---|---|"]
-    for row in result["cases"]:
-        truth = "+".join(row["truth"]) or "none"
-        if "predicted_shrink" not in row:
-            lines.append(f"| {row['case']} | {truth} | {row.get('skipped') or row.get('no_result')} | | | | |")
-            continue
-        lines.append(f"| {row['case']} | {truth} | {'+'.join(row['predicted_effects']) or 'none'} | "
-                     f"{row['effect_rms_mm']:.2f} | {row['noise_mm']:.2f} | {row['predicted_shrink']:.2f} | "
-                     f"{row['oracle_shrink']:.2f} |")
-    return "\n".join(lines) + "\n"
+        f"| clean cases with no catalog effect (`none` or `unexplained`) | {_pct(score['no_catalog_effect_clean'])} "
+        f"of {counts['none']} | >= 80% |",
+        f"| `none` on clean cases | {_pct(score['none_clean'])} of {counts['none']} | - |"]
+    if counts["out_of_catalog"]:
+        lines += [f"| `unexplained` on out-of-catalog cases | {_pct(score['unexplained_out_of_catalog'])} of "
+                  f"{counts['out_of_catalog']} | >= 80% |",
+                  f"| out-of-catalog cases with a catalog effect named | {score['catalog_effect_out_of_catalog']} | 0 |"]
+    if counts["pair"]:
+        lines.append(f"| pairs: exact / at least one found | {_pct(score['pair_exact'])} / "
+                     f"{_pct(score['pair_any_found'])} of {counts['pair']} | - |")
+    lines += [f"| predicted shrink vs oracle, mean error (cases with an effect: {shrink.get('cases', 0)}) | "
+              f"{shrink.get('mean', float('nan')):.1f} pp (median {shrink.get('median', float('nan')):.1f}, "
+              f"max {shrink.get('max', float('nan')):.1f}) | <= 10 pp |",
+              "", f"Skipped (no plant could be recorded): {counts['skipped']}; no result: {counts['no_result']}.", "",
+              "### Confusion matrix (single, clean and out-of-catalog cases)", "",
+              confusion_markdown(score["confusion"]), "",
+              "### Detection limit: top-1 against effect size / baseline residual", "",
+              f"![detection limit](detection_{family}.png)", "",
+              "| effect | size / residual | cases | top-1 |", "|---|---|---|---|"]
+    for effect_id, bins in score["detection_curve"].items():
+        for row in bins:
+            high = "inf" if row["ratio_high"] is None else f"{row['ratio_high']:g}"
+            lines.append(f"| {effect_id} | {row['ratio_low']:g}-{high} | {row['cases']} | {_pct(row['top1'])} |")
+    return lines + [""]
+
+
+def _detection_figure(curve: dict) -> Figure:
+    figure = new_figure(6.0, 4.0)
+    ax = figure.subplots()
+    for effect_id, bins in curve.items():
+        if bins:
+            centres = [(row["ratio_low"] + (row["ratio_high"] if row["ratio_high"] is not None
+                                            else 1.5 * max(row["ratio_low"], 1.0))) / 2 for row in bins]
+            ax.plot(centres, [row["top1"] for row in bins], marker="o", label=effect_id)
+    ax.set_xlabel("effect size / baseline residual (held-out RMS)")
+    ax.set_ylabel("top-1")
+    ax.set_ylim(-0.05, 1.05)
+    if curve:
+        ax.legend(fontsize=7)
+    return figure
 
 
 def _confusion_figure(confusion: dict) -> Figure:
@@ -99,7 +149,7 @@ def _confusion_figure(confusion: dict) -> Figure:
 def _shrink_figure(cases: list[dict]) -> Figure:
     figure = new_figure(5.0, 4.6)
     ax = figure.subplots()
-    scored = [r for r in cases if "predicted_shrink" in r]
+    scored = [r for r in cases if r.get("oracle_shrink") is not None]
     hit = [r for r in scored if sorted(r["predicted_effects"]) == sorted(r["truth"])]
     miss = [r for r in scored if r not in hit]
     for rows, label, color in ((hit, "verdict right", "tab:green"), (miss, "verdict wrong", "tab:red")):

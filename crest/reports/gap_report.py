@@ -107,11 +107,19 @@ def markdown(result: dict) -> str:
              f"- effect: **{verdict['effect']}**" + (f" (selected: {', '.join(verdict['effects'])})"
                                                     if len(verdict["effects"]) > 1 else ""),
              f"- held-out tip RMSE {verdict['holdout_rmse_before_mm']:.3f} mm -> "
-             f"{verdict['holdout_rmse_after_mm']:.3f} mm, shrink {100 * verdict['shrink']:.1f} %",
+             f"{verdict['holdout_rmse_after_mm']:.3f} mm, shrink {100 * verdict['shrink']:.1f} % on the report half "
+             f"({verdict['shrink_estimate']['method']}; on the selection half {100 * verdict['selection_shrink']:.1f} %)",
              f"- training RMSE of the baseline {base['train_rmse_mm']:.3f} mm; tracker noise floor "
              + (f"{floor:.3f} mm" if floor is not None else "unknown (no static holds in the logs)")]
     for effect_id, params in verdict["params"].items():
         lines.append(f"- {effect_id}: " + ", ".join(f"{k} = {v:.4g}" for k, v in params.items()))
+    if verdict["model_form_rms_mm"] is not None:
+        lines.append(f"- residual above the noise floor after the verdict (model form, what no effect in the "
+                     f"catalog removed): {verdict['model_form_rms_mm']:.3f} mm RMS, concentrated in "
+                     + (", ".join(verdict["residual_concentrated"]) or "no region (spread evenly)"))
+    if verdict["rejected"]:
+        lines += ["", "Why no candidate is the verdict (best three):", ""]
+        lines += [f"- {row['effect']}: " + ("; ".join(row["reasons"]) or "-") for row in verdict["rejected"]]
     lines += ["", "Residual after the verdict:", ""] + [f"- {line}" for line in verdict["residual"]]
     lines += ["", "## Where the gap lies (held-out, baseline model)", "",
               "Concentrated in: " + (", ".join(result["concentrated"]) or "no region (spread evenly)"), "",
@@ -124,7 +132,8 @@ def markdown(result: dict) -> str:
                      f"{row['samples']} | {row['concentration']:.2f} | {'-' if s is None else f'{100 * s:.0f} %'} |")
     lines += ["", "![tip traces](tip_traces.png)", "", "## Candidates (held-out)", "",
               "![candidates](candidates.png)", "",
-              "| effect | parameters | held-out RMSE mm | shrink | signature match | score |", "|---|---|---|---|---|---|"]
+              "| effect | parameters | held-out RMSE mm | shrink | signature match | score | rejected because |",
+              "|---|---|---|---|---|---|---|"]
     for c in result["candidates"] + result["pairs"]:
         params = c["params"] if len(c["effects"]) == 1 else {f"{e}.{k}": v for e, p in c["params"].items()
                                                             for k, v in p.items()}
@@ -132,7 +141,9 @@ def markdown(result: dict) -> str:
         rmse = "diverged" if c["holdout_rmse_mm"] is None else f"{c['holdout_rmse_mm']:.3f}"
         shrink_text = "-" if c["shrink"] is None else f"{100 * c['shrink']:.1f} %"
         score = "-" if c["score"] is None else f"{c['score']:.3f}"
-        lines.append(f"| {c['effect']} | {text} | {rmse} | {shrink_text} | {c['signature_match']:.2f} | {score} |")
+        match = "-" if c["signature_match"] is None else f"{c['signature_match']:.2f}"
+        why = "; ".join(c.get("rejected") or []) or "-"
+        lines.append(f"| {c['effect']} | {text} | {rmse} | {shrink_text} | {match} | {score} | {why} |")
     lines += ["", "## Signatures of the baseline residual", ""] + _signature_lines(result["signatures"])
     if verdict["base_parameter_change"]:
         lines += ["", "## Base parameters when the effect is added", "",

@@ -19,8 +19,11 @@ class CandidateEffect:
     physics: what it models and how, one or two sentences.
     param_names: names with units, in the order of `typical`, `lower` and `upper`.
     typical: a clearly visible magnitude on the default catheter (used by plants and drills).
-    lower, upper: the physical range (fit bounds).
+    lower, upper: the physical range (fit bounds); a fit that ends at a bound other than 0 (off)
+    wanted more than the effect can physically be, and is implausible.
     signature: the residual pattern it leaves when it is missing from a model.
+    signature_region: where in the motion adding it must remove error (a region the gap
+    diagnosis knows, see model.gap.plausibility), "" where the signature names no such region.
     apply: (terms, values) -> terms with this effect's fields set.
     """
 
@@ -31,6 +34,7 @@ class CandidateEffect:
     lower: tuple[float, ...]
     upper: tuple[float, ...]
     signature: str
+    signature_region: str
     apply: Callable[[EffectTerms, tuple[float, ...]], EffectTerms]
 
     def __post_init__(self) -> None:
@@ -49,6 +53,11 @@ class CandidateEffect:
             if not low <= value <= high:
                 raise ValueError(f"effect {self.id}: {name} = {value} is outside its physical range [{low}, {high}]")
         return values
+
+    def at_limit(self, values: tuple[float, ...], tolerance: float = 0.01) -> list[str]:
+        """Names of the parameters within `tolerance` of the range width of a bound other than 0."""
+        return [name for name, value, low, high in zip(self.param_names, values, self.lower, self.upper)
+                if any(bound != 0.0 and abs(value - bound) <= tolerance * (high - low) for bound in (low, high))]
 
     def terms(self, values: tuple[float, ...], base: EffectTerms = EffectTerms()) -> EffectTerms:
         """`base` with this effect switched on at `values`."""

@@ -15,24 +15,28 @@ EFFECTS: dict[str, CandidateEffect] = {e.id: e for e in (
         physics="tendon and drive-line stretch under tension: the tip sees u - c*T_drive",
         param_names=("compliance_mm_per_n",), typical=(0.05,), lower=(0.0,), upper=(0.5,),
         signature="articulation lags the command in proportion to tension: error grows with total tension",
+        signature_region="high tension",
         apply=lambda t, v: t.replace(tendon_compliance_mm_per_n=v[0])),
     CandidateEffect(
         id="backlash",
         physics="a dead band of width w in each tendon drive train, crossed at every reversal",
         param_names=("width_mm",), typical=(0.4,), lower=(0.0,), upper=(3.0,),
         signature="a flat dead band just after each reversal, independent of speed and load",
+        signature_region="after reversal",
         apply=lambda t, v: t.replace(backlash_mm=v[0])),
     CandidateEffect(
         id="lumen_compression",
         physics="lumens pushed toward the neutral axis under load near the base: the moment arm shrinks",
         param_names=("coef_per_n", "extent_mm"), typical=(0.03, 20.0), lower=(0.0, 1.0), upper=(0.5, 200.0),
         signature="less bending than predicted at high articulation, growing with tension, near the base",
+        signature_region="high articulation",
         apply=lambda t, v: t.replace(lumen_compression_per_n=v[0], lumen_compression_extent_mm=v[1])),
     CandidateEffect(
         id="tube_friction",
         physics="catheter/support-tube friction: the free length lags the insertion axis by a play",
         param_names=("play_mm",), typical=(2.0,), lower=(0.0,), upper=(10.0,),
         signature="error along the catheter after insertion reversals, tied to free-length changes",
+        signature_region="",
         apply=lambda t, v: t.replace(tube_play_mm=v[0])),
     CandidateEffect(
         id="gravity",
@@ -40,12 +44,14 @@ EFFECTS: dict[str, CandidateEffect] = {e.id: e for e in (
         param_names=("g_x_m_s2", "g_y_m_s2", "g_z_m_s2"), typical=(0.0, -9.81, 0.0),
         lower=(-20.0, -20.0, -20.0), upper=(20.0, 20.0, 20.0),   # up to 2 g: a fluid-filled catheter weighs more
         signature="a fixed-direction offset that grows with free length, present even at zero load",
+        signature_region="zero load",
         apply=lambda t, v: t.replace(gravity_m_s2=(v[0], v[1], v[2]))),
     CandidateEffect(
         id="torsion",
         physics="twist of the lumens along the catheter: each bending plane couples into the other",
         param_names=("twist_rad",), typical=(0.25,), lower=(-1.0,), upper=(1.0,),
         signature="error out of the commanded bending plane, proportional to articulation",
+        signature_region="high articulation",
         apply=lambda t, v: t.replace(twist_rad=v[0])),
     CandidateEffect(
         id="tracker_offset",
@@ -53,12 +59,14 @@ EFFECTS: dict[str, CandidateEffect] = {e.id: e for e in (
         param_names=("dx_mm", "dy_mm", "dz_mm"), typical=(1.0, -0.8, 0.6),
         lower=(-10.0, -10.0, -10.0), upper=(10.0, 10.0, 10.0),
         signature="a constant bias everywhere, including static holds at zero load",
+        signature_region="zero load",
         apply=lambda t, v: t.replace(tracker_offset_mm=(v[0], v[1], v[2]))),
     CandidateEffect(
         id="rate_friction",
         physics="velocity-strengthening tendon friction: Fs*(1 + c*|v|)",
         param_names=("coef_s_per_mm",), typical=(0.1,), lower=(0.0,), upper=(5.0,),
         signature="hysteresis loops that widen with speed; static holds agree",
+        signature_region="fast",
         apply=lambda t, v: t.replace(rate_friction_s_per_mm=v[0])),
     CandidateEffect(
         id="precurvature",
@@ -66,6 +74,7 @@ EFFECTS: dict[str, CandidateEffect] = {e.id: e for e in (
         param_names=("kappa_x_per_mm", "kappa_y_per_mm"), typical=(0.002, -0.001),
         lower=(-0.02, -0.02), upper=(0.02, 0.02),
         signature="a bend at zero load in a fixed plane, scaling with free length",
+        signature_region="zero load",
         apply=lambda t, v: t.replace(precurvature_per_mm=(v[0], v[1]))),
     CandidateEffect(
         id="rate_lag",

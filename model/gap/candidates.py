@@ -8,11 +8,14 @@ Ranking score (higher is better):
 
     score = shrink - PARAMETER_PENALTY * n_params + SIGNATURE_WEIGHT * match
 
-shrink = 1 - RMSE_after / RMSE_before on held-out data; match = cosine between the
-candidate's correction c = tip_candidate - tip_baseline and the baseline's residual
--e = tip_measured - tip_baseline over all held-out samples (1: the candidate moves the tip
-exactly the way the residual points; 0: unrelated). Whether the best is a found effect is
-decided in `model.gap.significance`.
+shrink = 1 - RMSE_after / RMSE_before on the selection half of the held-out data
+(`model.gap.holdout_split`); match = cosine between the candidate's correction
+c = tip_candidate - tip_baseline and the baseline's residual -e = tip_measured - tip_baseline
+over the same samples (1: the candidate moves the tip exactly the way the residual points; 0:
+unrelated). The same RMSE and shrink on the report half are kept beside them: those are the
+numbers the diagnosis publishes. A candidate whose held-out prediction failed (the model
+diverged or crawled: infinite errors) scores -inf. Whether the best is a found effect is
+decided in `model.gap.significance` and `model.gap.plausibility`.
 
 Each fit also reports its ablation: the same base parameters with the effect switched off. If
 that is as good, the fit improved on the baseline by refitting, not through the effect, and
@@ -32,6 +35,7 @@ import numpy as np
 from model.effects.catalog import effect
 from model.gap.calibration import (MIN_ITERATION_LIMIT, ZERO_OFFSETS_MM, ModelFit, calibrate, explore,
                                    iteration_limit, probe_costs, rmse_mm, tip_errors)
+from model.gap.holdout_split import HoldoutSplit
 from model.gap.recording import Recording
 from model.gap.simulation import Resolution, catheter_for
 from model.gap.starting_points import probe_values, start_values
@@ -45,7 +49,10 @@ FINAL_FITS = 2              # explored starts fitted to the end (EXPLORE); the l
 
 @dataclass(frozen=True)
 class CandidateResult:
-    """One fitted effect set: fit, held-out RMSE and held-out errors, shrink, match and score.
+    """One fitted effect set: fit, held-out errors, RMSE, shrink, match and score.
+
+holdout_rmse_mm, shrink, signature_match and score: on the selection half of the held-out
+samples; report_rmse_mm and report_shrink: on the report half (see module doc).
 
     ablated_*: the fit's base parameters with the effects switched off (training RMSE and
     held-out errors; inf and () when not computed).
@@ -58,9 +65,16 @@ class CandidateResult:
     shrink: float
     signature_match: float
     score: float
+    report_rmse_mm: float
+    report_shrink: float
     seconds: float = 0.0
     ablated_train_rmse_mm: float = math.inf
     ablated_holdout_errors: tuple[np.ndarray, ...] = ()
+
+    @property
+    def failed(self) -> bool:
+        """Its held-out prediction failed (diverged or over its iteration limit) on some sample."""
+        return not all(np.isfinite(e).all() for e in self.holdout_errors)
 
     @property
     def n_params(self) -> int:
@@ -79,12 +93,13 @@ class CandidateResult:
         return {"effect": "+".join(self.effects) if self.effects else "none", "effects": list(self.effects),
                 "params": params if len(self.effects) != 1 else params[self.effects[0]],
                 "n_params": self.n_params, "train_rmse_mm": number(self.fit.train_rmse_mm),
-                "holdout_rmse_mm": number(self.holdout_rmse_mm), "shrink": number(self.shrink),
-                "signature_match": self.signature_match, "score": number(self.score),
+                "holdout_rmse_mm": number(self.report_rmse_mm), "shrink": number(self.report_shrink),
+                "selection_rmse_mm": number(self.holdout_rmse_mm), "selection_shrink": number(self.shrink),
+                "signature_match": number(self.signature_match), "score": number(self.score),
                 "ablated_train_rmse_mm": number(self.ablated_train_rmse_mm),
                 "ablated_holdout_rmse_mm": number(rmse_mm(self.ablated_holdout_errors))
                 if self.ablated_holdout_errors else None,
-                "diverged": not np.isfinite(self.holdout_rmse_mm), "flags": list(self.fit.flags),
+                "diverged": self.failed, "flags": list(self.fit.flags),
                 "model_runs": self.fit.model_runs, "seconds": self.seconds}
 
 
@@ -103,7 +118,7 @@ class FitTask:
     train: tuple[Recording, ...]
     holdout: tuple[Recording, ...]     # already at the fit resolution
     baseline_errors: tuple[np.ndarray, ...]
-    baseline_rmse_mm: float
+    split: HoldoutSplit
     resolution: Resolution
     iterations: int = CANDIDATE_ITERATIONS
     mode: str = EXPLORE
@@ -161,7 +176,7 @@ def run_task(task: FitTask) -> CandidateResult:
     train_limit = iteration_limit(task.start, train, task.resolution)
     holdout_limit = max(int(train_limit * sum(map(len, task.holdout)) / sum(map(len, train))), MIN_ITERATION_LIMIT)
     errors = tuple(tip_errors(fit, task.holdout, task.resolution, holdout_limit))
-    result = evaluate(tuple(task.effects), fit, errors, task.baseline_errors, task.baseline_rmse_mm)
+    result = evaluate(tuple(task.effects), fit, errors, task.baseline_errors, task.split)
     ablated = ModelFit(fit.params, fit.zero_offsets_mm, {})
     return dataclasses.replace(
         result, seconds=time.perf_counter() - clock,
@@ -170,17 +185,24 @@ def run_task(task: FitTask) -> CandidateResult:
 
 
 def evaluate(effects: tuple[str, ...], fit: ModelFit, errors: Sequence[np.ndarray],
-             baseline_errors: Sequence[np.ndarray], baseline_rmse_mm: float) -> CandidateResult:
-    """Held-out RMSE, shrink, signature match and score of a fitted effect set."""
-    holdout_rmse = rmse_mm(errors)
-    shrink = 1.0 - holdout_rmse / baseline_rmse_mm if baseline_rmse_mm > 0 else 0.0
-    e = np.concatenate(baseline_errors).ravel()
-    c = np.concatenate(errors).ravel() - e
+             baseline_errors: Sequence[np.ndarray], split: HoldoutSplit) -> CandidateResult:
+    """Held-out RMSE, shrink, signature match and score of a fitted effect set (see module doc)."""
+    def rmse_and_shrink(part: Callable[[Sequence[np.ndarray]], list[np.ndarray]]) -> tuple[float, float]:
+        before, after = rmse_mm(part(baseline_errors)), rmse_mm(part(errors))
+        if not np.isfinite(after):
+            return math.inf, -math.inf
+        return after, 1.0 - after / before if before > 0 else 0.0
+
+    holdout_rmse, shrink = rmse_and_shrink(split.selected)
+    report_rmse, report_shrink = rmse_and_shrink(split.reported)
+    e = np.concatenate(split.selected(baseline_errors)).ravel()
+    c = np.concatenate(split.selected(errors)).ravel() - e
     norm = np.linalg.norm(c) * np.linalg.norm(e)
     match = float(-(c @ e) / norm) if np.isfinite(norm) and norm > 0 else 0.0
     n_params = sum(len(effect(effect_id).param_names) for effect_id in effects)
     score = shrink - PARAMETER_PENALTY * n_params + SIGNATURE_WEIGHT * match
-    return CandidateResult(effects, fit, holdout_rmse, tuple(errors), shrink, match, score)
+    return CandidateResult(effects, fit, holdout_rmse, tuple(errors), shrink, match, score, report_rmse,
+                           report_shrink)
 
 
 def run_tasks(tasks: Sequence[FitTask], executor: Executor | None = None,
@@ -203,5 +225,5 @@ def run_tasks(tasks: Sequence[FitTask], executor: Executor | None = None,
 
 
 def ranked(results: Sequence[CandidateResult]) -> list[CandidateResult]:
-    """Best score first."""
-    return sorted(results, key=lambda result: -result.score)
+    """Best score first (a failed prediction, score -inf or NaN, last)."""
+    return sorted(results, key=lambda result: -result.score if np.isfinite(result.score) else math.inf)

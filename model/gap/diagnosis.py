@@ -27,18 +27,22 @@ from model.effects.catalog import EFFECTS
 from model.gap.calibration import ModelFit, calibrate_base, rmse_mm, tip_errors
 from model.gap.candidates import (CANDIDATE_ITERATIONS, CONTINUE, EXPLORE, PROBE, CandidateResult, FitTask,
                                   evaluate, ranked, run_tasks)
+from model.gap.finite_json import finite_tree
 from model.gap.free_parameters import base_values
+from model.gap.holdout_split import HoldoutSplit, split_holdout
 from model.gap.noise import tracker_noise_mm
+from model.gap.plausibility import range_reasons, signature_concentration, signature_reasons
 from model.gap.recording import Recording, RecordingError
 from model.gap.regions import breakdown, concentrated, regions, shrink_by_region
-from model.gap.sample_features import compute_features
-from model.gap.significance import is_meaningful
+from model.gap.sample_features import SampleFeatures, compute_features
+from model.gap.significance import is_meaningful, is_significant_residual, model_form_rms_mm
 from model.gap.signatures import describe, signatures
 from model.gap.simulation import Resolution, predict_tips, predict_tips_and_tension
 from model.gap.starting_points import start_values
 from model.params import CatheterParams
 
-FORMAT = "crest-gap/1"
+FORMAT = "crest-gap/2"
+UNEXPLAINED = "unexplained"
 
 
 @dataclass(frozen=True)
@@ -82,12 +86,12 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
                               on_fit=lambda done, total: say(f"baseline: {done}/{total} starts fitted"))
     held = res.prepare(holdout)
     base_errors = _holdout_errors(baseline, held, res)
-    base_rmse = rmse_mm(base_errors)
+    split = split_holdout([len(e) for e in base_errors])
     noise = tracker_noise_mm(list(train) + list(holdout))
     timing["baseline"] = time.perf_counter() - clock
 
     def task(effects: dict, start: ModelFit, mode: str = EXPLORE) -> FitTask:
-        return FitTask(effects, start, prior, tuple(train), tuple(held), tuple(base_errors), base_rmse, res,
+        return FitTask(effects, start, prior, tuple(train), tuple(held), tuple(base_errors), split, res,
                        settings.candidate_iterations, mode)
 
     ids = list(settings.effects)
@@ -105,23 +109,47 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
                                  key=lambda pair: pair[0].train_rmse_mm)
     if best_base is not baseline:
         say(f"baseline: improved from {baseline.train_rmse_mm:.3f} to {best_base.train_rmse_mm:.3f} mm (training)")
-        baseline, base_errors, base_rmse = best_base, best_errors, rmse_mm(best_errors)
-        singles = [replace(evaluate(r.effects, r.fit, r.holdout_errors, base_errors, base_rmse), seconds=r.seconds,
+        baseline, base_errors = best_base, best_errors
+        singles = [replace(evaluate(r.effects, r.fit, r.holdout_errors, base_errors, split), seconds=r.seconds,
                            ablated_train_rmse_mm=r.ablated_train_rmse_mm,
                            ablated_holdout_errors=r.ablated_holdout_errors) for r in singles]
     singles = ranked(singles)
+    base_rmse = rmse_mm(base_errors)
     timing["candidates"] = time.perf_counter() - clock - sum(timing.values())
 
-    def is_found(result: CandidateResult) -> bool:
-        """Meaningful against the baseline, and against its own ablation: the effect, not the refit
-        of the base parameters that came with it, removes the error (a candidate whose effect
-        ended switched off can still beat a baseline that generalises worse)."""
-        return (is_meaningful(base_rmse, result.holdout_rmse_mm, noise)
-                and is_meaningful(rmse_mm(result.ablated_holdout_errors), result.holdout_rmse_mm, noise))
+    zeros = baseline.zero_offsets_mm
+    tensions = [predict_tips_and_tension(baseline.params, baseline.terms(), np.asarray(zeros), r, res)[1]
+                if r.tendon_force_n is None else None for r in held]
+    features = compute_features(held, zeros, tensions)
+    chosen_features = features.subset(split.selection_mask)
+
+    def rejections(result: CandidateResult, before: CandidateResult | None = None) -> list[str]:
+        """Why the result is not a found effect (empty: it is). It must have predicted every held-out
+        sample; be meaningful (selection half) against the baseline (`before`: the single it adds a
+        second effect to) and against its own ablation, the same fit with the effect switched off (the
+        effect, not the refit of the base parameters that came with it, removes the error); and be
+        plausible: its parameters inside their physical range, its gain where its signature says."""
+        if result.failed:
+            return ["its held-out prediction failed (the model diverged or was given up): never a verdict"]
+        before_errors = split.selected(before.holdout_errors if before else base_errors)
+        before_rmse = rmse_mm(before_errors)
+        reasons = []
+        if not is_meaningful(before_rmse, result.holdout_rmse_mm, noise):
+            reasons.append(f"not significant: {before_rmse:.3f} -> {result.holdout_rmse_mm:.3f} mm on the selection "
+                           "half removes no more than noise and fitting freedom explain")
+        elif not before and result.ablated_holdout_errors and not is_meaningful(
+                rmse_mm(split.selected(result.ablated_holdout_errors)), result.holdout_rmse_mm, noise):
+            reasons.append(f"the refit, not the effect, removes the error: with the effect switched off the fit "
+                           f"reaches {rmse_mm(split.selected(result.ablated_holdout_errors)):.3f} mm")
+        added = result.effects[-1]
+        reasons += range_reasons(added, result.fit.effects[added], train[0].flexible_length_mm)
+        reasons += signature_reasons(added, chosen_features, np.concatenate(before_errors),
+                                     np.concatenate(split.selected(result.holdout_errors)))[0]
+        return reasons
 
     chosen: list[CandidateResult] = []
     pairs: list[CandidateResult] = []
-    eligible = [r for r in singles if is_found(r)]
+    eligible = [r for r in singles if not rejections(r)]
     if eligible and settings.pair_candidates == 0:
         chosen = [eligible[0]]
     elif eligible:
@@ -132,19 +160,16 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
         continued, *pairs = run_tasks([task(dict(best.fit.effects), best.fit, CONTINUE)]
                                       + [task({**best.fit.effects, other: start_values(other)}, best.fit, PROBE)
                                          for other in others], pool)
-        if continued.fit.train_rmse_mm < best.fit.train_rmse_mm:   # the control got further: it is the single
+        # the control got further: it is the single, if it still predicts and still is a found effect
+        if continued.fit.train_rmse_mm < best.fit.train_rmse_mm and not rejections(continued):
             singles[singles.index(best)] = best = replace(continued, seconds=best.seconds + continued.seconds)
         chosen = [best]
         pairs = ranked(pairs)
-        if pairs and is_meaningful(best.holdout_rmse_mm, pairs[0].holdout_rmse_mm, noise):
+        if pairs and not rejections(pairs[0], best):
             chosen.append(pairs[0])
     timing["pairs"] = time.perf_counter() - clock - sum(timing.values())
 
     say("where: residual by region and signatures")
-    zeros = baseline.zero_offsets_mm
-    tensions = [predict_tips_and_tension(baseline.params, baseline.terms(), np.asarray(zeros), r, res)[1]
-                if r.tendon_force_n is None else None for r in held]
-    features = compute_features(held, zeros, tensions)
     found = regions(features)
     base_stack = np.concatenate(base_errors)
     where = breakdown(found, base_stack)
@@ -158,28 +183,41 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
     after_signature = signatures(features, after_stack, held, after_tips, zeros, noise) if final else signature
     timing["where"] = time.perf_counter() - clock - sum(timing.values())
 
+    base_report_rmse = rmse_mm(split.reported(base_errors))
+    after_rmse = rmse_mm([after_stack])
+    after_where = breakdown(found, after_stack)
+    unexplained = not final and is_significant_residual(base_rmse, noise)
     verdict = {
-        "effect": chosen[0].effects[0] if chosen else "none",
+        "effect": chosen[0].effects[0] if chosen else UNEXPLAINED if unexplained else "none",
         "effects": list(final.effects) if final else [],
-        "holdout_rmse_before_mm": base_rmse,
-        "holdout_rmse_after_mm": final.holdout_rmse_mm if final else base_rmse,
-        "shrink": final.shrink if final else 0.0,
+        "holdout_rmse_before_mm": base_report_rmse,
+        "holdout_rmse_after_mm": final.report_rmse_mm if final else base_report_rmse,
+        "shrink": final.report_shrink if final else 0.0,
+        "selection_shrink": final.shrink if final else 0.0,
+        "shrink_estimate": split.as_dict(),
         "params": final.fit.effect_params() if final else {},
         "shrink_by_region": shrink_by_region(found, base_stack, after_stack) if final else [],
         "base_parameter_change": _base_change(baseline, final.fit) if final else [],
-        "residual": describe(after_signature, breakdown(found, after_stack), rmse_mm([after_stack])),
+        "residual": describe(after_signature, after_where, after_rmse),
+        "residual_concentrated": [row["region"] for row in concentrated(after_where)],
+        "model_form_rms_mm": model_form_rms_mm(after_rmse, noise),
+        "rejected": [] if final else [{"effect": r.effects[0], "reasons": rejections(r)} for r in singles[:3]],
         "fit": after_fit.as_dict(),
     }
     timing["total"] = time.perf_counter() - clock
-    return {
+    result = {
         "format": FORMAT,
-        "baseline": {"train_rmse_mm": baseline.train_rmse_mm, "holdout_rmse_mm": base_rmse, "noise_mm": noise,
+        "baseline": {"train_rmse_mm": baseline.train_rmse_mm, "holdout_rmse_mm": base_rmse,
+                     "report_rmse_mm": base_report_rmse, "noise_mm": noise,
                      "noise_floor_mm": None if noise is None else float(np.sqrt(3) * noise),
+                     "residual_significant": is_significant_residual(base_rmse, noise),
                      "fit": baseline.as_dict()},
         "where": where,
         "concentrated": [row["region"] for row in concentrated(where)],
         "signatures": signature,
-        "candidates": [{**r.as_dict(), "found": is_found(r)} for r in singles],
+        "candidates": [{**r.as_dict(), "found": not (reasons := rejections(r)), "rejected": reasons,
+                        "signature_concentration": _concentration(r, chosen_features, split, base_errors)}
+                       for r in singles],
         "pairs": [r.as_dict() for r in pairs],
         "verdict": verdict,
         "settings": {**asdict(settings), "train": [r.name for r in train], "holdout": [r.name for r in holdout],
@@ -187,6 +225,17 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
                                   "flexible_length_mm": train[0].flexible_length_mm}},
         "timing_s": timing,
     }
+    result, nulls = finite_tree(result)
+    return {**result, "non_finite": nulls}
+
+
+def _concentration(result: CandidateResult, features: SampleFeatures, split: HoldoutSplit,
+                   base_errors: Sequence[np.ndarray]) -> dict:
+    """The candidate's gain concentration in its signature region (selection half), for the JSON."""
+    value, region = (None, "") if result.failed else signature_concentration(
+        result.effects[0], features, np.concatenate(split.selected(base_errors)),
+        np.concatenate(split.selected(result.holdout_errors)))
+    return {"region": region or None, "concentration": value}
 
 
 def _holdout_errors(fit: ModelFit, held: Sequence[Recording], res: Resolution) -> list[np.ndarray]:

@@ -16,7 +16,7 @@ and with time derivatives (central differences) the motion class of each sample:
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -40,6 +40,10 @@ class SampleFeatures:
     tension_n: np.ndarray            # total tendon tension (measured, else modelled)
     time_fraction: np.ndarray        # position along its recording, 0..1
     recording: np.ndarray            # index of the recording
+
+    def subset(self, mask: np.ndarray) -> "SampleFeatures":
+        """The samples where `mask` [n] is True."""
+        return SampleFeatures(*(getattr(self, f.name)[mask] for f in fields(self)))
 
 
 def compute_features(recordings: Sequence[Recording], zero_offsets_mm: Sequence[float],

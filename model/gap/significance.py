@@ -31,3 +31,22 @@ def is_meaningful(rmse_before_mm: float, rmse_after_mm: float, noise_mm: float |
     gain = rmse_before_mm ** 2 - rmse_after_mm ** 2
     return shrink >= MIN_SHRINK and gain >= max(MIN_GAIN_OVER_NOISE * floor,
                                                 MIN_EXCESS_FRACTION * (rmse_before_mm ** 2 - floor))
+
+
+RESIDUAL_EXCESS = 0.5             # a residual is significant when its squared RMSE exceeds the floor by half
+
+
+def is_significant_residual(rmse_mm: float, noise_mm: float | None) -> bool:
+    """Is a held-out error more than the tracker noise can explain: rmse^2 >= (1 + RESIDUAL_EXCESS) f^2
+    with f^2 = 3 sigma^2 (rmse >= 1.22 f)? Without a noise estimate the data cannot tell: False."""
+    if noise_mm is None or not np.isfinite(rmse_mm):
+        return False
+    return rmse_mm ** 2 >= (1.0 + RESIDUAL_EXCESS) * 3.0 * noise_mm ** 2
+
+
+def model_form_rms_mm(rmse_mm: float, noise_mm: float | None) -> float | None:
+    """The part of a held-out error above the noise floor, sqrt(max(rmse^2 - f^2, 0)) (mm): what a
+    model could remove at all; None without a noise estimate."""
+    if noise_mm is None or not np.isfinite(rmse_mm):
+        return None
+    return float(np.sqrt(max(rmse_mm ** 2 - 3.0 * noise_mm ** 2, 0.0)))

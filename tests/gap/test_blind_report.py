@@ -7,19 +7,20 @@ def case(index, kind, truth, predicted, predicted_shrink, oracle):
     return {"case": index, "kind": kind, "truth": truth, "predicted": predicted or "none",
             "predicted_effects": [predicted] if predicted else [], "predicted_shrink": predicted_shrink,
             "oracle_shrink": oracle, "shrink_error_pp": 100 * abs(predicted_shrink - oracle),
-            "effect_rms_mm": 0.8, "noise_mm": 0.1, "above_noise": True}
+            "effect_rms_mm": 0.8, "noise_mm": 0.1, "above_noise": True, "relative_size": 0.8,
+            "above_detection_limit": True}
 
 
 def result():
     rows = [case(0, "single", ["backlash"], "backlash", 0.9, 0.92), case(1, "single", ["gravity"], None, 0.0, 0.1),
             case(2, "none", [], None, 0.0, 0.0), {"case": 3, "kind": "single", "truth": ["torsion"],
                                                  "skipped": "the plant failed in 6 draws"}]
-    return {"score": score(rows), "cases": rows,
+    return {"score": {"dahl": score(rows)}, "cases": rows,
             "settings": {"seed": 1, "excitation": "short", "path": "virtual testbed", "seconds": 600.0}}
 
 
 def test_confusion_table_lists_true_effects_against_verdicts():
-    table = confusion_markdown(result()["score"]["confusion"]).splitlines()
+    table = confusion_markdown(result()["score"]["dahl"]["confusion"]).splitlines()
     assert table[0] == "| true \\ verdict | backlash | gravity | none |"
     assert "| backlash | 1 | . | . |" in table and "| gravity | . | . | 1 |" in table and "| none | . | . | 1 |" in table
 
@@ -27,7 +28,10 @@ def test_confusion_table_lists_true_effects_against_verdicts():
 def test_report_writes_markdown_and_figures(tmp_path):
     path = write_blind_report(result(), tmp_path / "blind")
     text = path.read_text()
-    assert "| top-1 on single effects | 50% of 2 | >= 90% |" in text
-    assert "| 3 | torsion | the plant failed in 6 draws |" in text
-    assert (tmp_path / "blind" / "confusion.png").stat().st_size > 1000
+    assert "| top-1 on single effects | 50% of 2 | - |" in text
+    assert "| top-1 above the detection limit | 50% of 2 | >= 90% |" in text
+    assert "| dahl | 3 | torsion | the plant failed in 6 draws |" in text
+    assert "| backlash | 0.7-1 | 1 | 100% |" in text       # the detection-limit table
+    assert (tmp_path / "blind" / "confusion_dahl.png").stat().st_size > 1000
+    assert (tmp_path / "blind" / "detection_dahl.png").stat().st_size > 1000
     assert (tmp_path / "blind" / "shrink.png").stat().st_size > 1000

@@ -34,7 +34,9 @@ def test_scores_count_hits_misses_and_shrink_errors():
     assert result["pair_exact"] == 0.5 and result["pair_any_found"] == 1.0
     assert result["confusion"]["gravity"]["tracker_offset"] == 1 and result["confusion"]["none"]["torsion"] == 1
     assert result["shrink_error_pp"]["max"] == pytest.approx(20.0)
-    assert result["shrink_error_pp"]["within_10pp"] == pytest.approx(5 / 6)
+    # clean cases are left out of the shrink error (both shrinks are about 0 there: they would flatter it)
+    assert result["shrink_error_pp"]["cases"] == 4
+    assert result["shrink_error_pp"]["within_10pp"] == pytest.approx(3 / 4)
 
 
 def test_effects_below_the_tracker_noise_are_scored_apart_but_still_counted():
@@ -43,3 +45,42 @@ def test_effects_below_the_tracker_noise_are_scored_apart_but_still_counted():
     result = score(rows)
     assert result["top1_single"] == 0.5 and result["top1_single_above_noise"] == 1.0
     assert result["counts"]["single_below_noise"] == 1
+
+
+def test_clean_cases_count_none_and_unexplained_as_right_and_out_of_catalog_cases_apart():
+    rows = [row("none", [], "none"), row("none", [], "unexplained"), row("none", [], "gravity"),
+            row("out_of_catalog", ["sheath_creep"], "unexplained"), row("out_of_catalog", ["stiffness_step"], "torsion")]
+    result = score(rows)
+    assert result["no_catalog_effect_clean"] == pytest.approx(2 / 3) and result["none_clean"] == pytest.approx(1 / 3)
+    assert result["unexplained_out_of_catalog"] == 0.5 and result["catalog_effect_out_of_catalog"] == 1
+    assert result["confusion"]["stiffness_step"]["torsion"] == 1 and result["counts"]["out_of_catalog"] == 2
+    assert result["shrink_error_pp"] is None        # no case with a catalog effect: nothing to compare
+
+
+def test_detection_curve_bins_top1_by_effect_size_relative_to_the_baseline_residual():
+    rows = [{**row("single", ["backlash"], "backlash"), "relative_size": 0.8, "above_detection_limit": True},
+            {**row("single", ["backlash"], "none"), "relative_size": 0.05, "above_detection_limit": False},
+            {**row("single", ["backlash"], "backlash"), "relative_size": 0.06, "above_detection_limit": False}]
+    result = score(rows)
+    assert result["detection_curve"]["backlash"] == [
+        {"ratio_low": 0.0, "ratio_high": 0.1, "cases": 2, "top1": 0.5},
+        {"ratio_low": 0.7, "ratio_high": 1.0, "cases": 1, "top1": 1.0}]
+    assert result["top1_single_above_detection"] == 1.0 and result["counts"]["single_above_detection"] == 1
+
+
+def test_rod_draw_holds_clean_single_and_out_of_catalog_cases_in_the_rods_own_terms(tmp_path):
+    from crest.backend import plant_effect_ranges, plant_from_description
+    from crest.gap.blind_benchmark import write_plant_config
+
+    cases = draw_cases(20, seed=3, prior=CatheterParams.from_toml(), family="rod")
+    kinds = [c.kind for c in cases]
+    assert kinds.count("none") == 4 and kinds.count("out_of_catalog") == 4 and kinds.count("pair") == 0
+    ranges = plant_effect_ranges("rod")
+    assert {c.effects[0] for c in cases if c.kind == "out_of_catalog"} <= {
+        e for e, spec in ranges.items() if not spec["in_catalog"]}
+    for case in cases:
+        for effect_id, params in case.plant.effects.items():     # inside the drawing range, by name
+            for name, value in params.items():
+                spec = ranges[effect_id]["params"][name]
+                assert spec["low"] <= abs(value) <= spec["high"] or spec["draw"] == "uniform"
+        plant_from_description(write_plant_config(case, tmp_path / f"case_{case.index}"))   # the plant accepts it

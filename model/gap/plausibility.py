@@ -1,0 +1,100 @@
+"""Is a candidate's fit physically plausible, and does its improvement sit where its signature says?
+
+Two checks, each giving a reason when it fails (a fit that passes both has no reasons):
+
+1. Range: every effect parameter inside its physical range (model.effects.catalog) and not at
+   a bound other than 0 (within 1 % of the range width): a fit pushed to the limit wanted more
+   than the effect can be, i.e. it absorbs something else. Lumen compression acts near the base:
+   its extent may reach NEAR_BASE_FRACTION of the catheter's flexible length, no further (a
+   compression along the whole catheter is a different moment arm or stiffness, i.e. model form:
+   on the rod plant without effects a fit with extent 181 mm took 48 % of the residual).
+2. Signature: with the per-sample gain g_t = |e_before,t|^2 - |e_after,t|^2 (mm^2) on the
+   selection half, the gain's concentration in the effect's signature region R,
+
+       C_R = (sum_{t in R} g_t / sum_t g_t) / (|R| / n),
+
+   must reach MIN_SIGNATURE_CONCENTRATION: an effect that removes error mostly elsewhere (a
+   gravity fit that improves only the strongly bent samples, not the straight ones where sag
+   is present at zero load) does not explain the residual the way its physics would. A region
+   with fewer than MIN_REGION_SAMPLES samples cannot tell and passes.
+
+The signature regions (the catalog's `signature_region`):
+    zero load          articulation < ZERO_LOAD_DEG
+    high articulation  articulation >= HIGH_ARTICULATION_DEG
+    high tension       total tendon tension at or above its median
+    after reversal     the motion class "after reversal"
+    fast               moving with the fastest tendon at FAST_MM_S or more
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from model.effects.catalog import effect
+from model.gap.sample_features import SampleFeatures
+
+MIN_SIGNATURE_CONCENTRATION = 0.5
+MIN_REGION_SAMPLES = 10
+ZERO_LOAD_DEG = 15.0
+HIGH_ARTICULATION_DEG = 45.0
+FAST_MM_S = 2.0
+NEAR_BASE_FRACTION = 0.5
+
+
+def signature_region(name: str, features: SampleFeatures) -> np.ndarray:
+    """The mask of a signature region (see module doc) over the samples of `features`."""
+    f = features
+    masks = {
+        "zero load": lambda: f.articulation_deg < ZERO_LOAD_DEG,
+        "high articulation": lambda: f.articulation_deg >= HIGH_ARTICULATION_DEG,
+        "high tension": lambda: f.tension_n >= np.median(f.tension_n),
+        "after reversal": lambda: f.motion == "after reversal",
+        "fast": lambda: np.isin(f.motion, ("loading", "unloading", "after reversal", "sideways"))
+        & (f.speed_mm_s >= FAST_MM_S),
+    }
+    if name not in masks:
+        raise ValueError(f"unknown signature region {name!r}; known: {', '.join(masks)}")
+    return masks[name]()
+
+
+def range_reasons(effect_id: str, values: tuple[float, ...], flexible_length_mm: float | None = None) -> list[str]:
+    """Why the effect's fitted values are implausible (empty: plausible); flexible_length_mm: the
+    catheter's, for the effects whose range depends on it (None: not checked)."""
+    candidate = effect(effect_id)
+    reasons = []
+    if effect_id == "lumen_compression" and flexible_length_mm is not None \
+            and values[1] > NEAR_BASE_FRACTION * flexible_length_mm:
+        reasons.append(f"lumen_compression.extent_mm = {values[1]:.4g} reaches beyond {NEAR_BASE_FRACTION:g} of the "
+                       f"flexible length ({flexible_length_mm:g} mm): a compression near the base does not")
+    for name, value, low, high in zip(candidate.param_names, values, candidate.lower, candidate.upper):
+        if not low <= value <= high:
+            reasons.append(f"{effect_id}.{name} = {value:.4g} is outside its physical range [{low:g}, {high:g}]")
+    reasons += [f"{effect_id}.{name} = {dict(zip(candidate.param_names, values))[name]:.4g} is at the limit of "
+                f"its physical range [{low:g}, {high:g}]: the fit wanted more than the effect can be"
+                for name, low, high in zip(candidate.param_names, candidate.lower, candidate.upper)
+                if name in candidate.at_limit(values)]
+    return reasons
+
+
+def signature_concentration(effect_id: str, features: SampleFeatures, before_mm: np.ndarray,
+                            after_mm: np.ndarray) -> tuple[float | None, str]:
+    """C_R of the effect's gain (see module doc) and its region's name; None where it cannot tell
+    (no region, too few samples in it, or no gain at all)."""
+    region_name = effect(effect_id).signature_region
+    if not region_name:
+        return None, ""
+    region = signature_region(region_name, features)
+    gain = np.sum(np.asarray(before_mm) ** 2, axis=1) - np.sum(np.asarray(after_mm) ** 2, axis=1)
+    total = float(gain.sum())
+    if region.sum() < MIN_REGION_SAMPLES or not np.isfinite(total) or total <= 0.0:
+        return None, region_name
+    return float(gain[region].sum() / total / region.mean()), region_name
+
+
+def signature_reasons(effect_id: str, features: SampleFeatures, before_mm: np.ndarray,
+                      after_mm: np.ndarray) -> tuple[list[str], float | None]:
+    """Why the effect's improvement does not sit where its signature says (empty: it does), and C_R."""
+    concentration, region_name = signature_concentration(effect_id, features, before_mm, after_mm)
+    if concentration is None or concentration >= MIN_SIGNATURE_CONCENTRATION:
+        return [], concentration
+    return [f"{effect_id} removes error mostly outside its signature region ({region_name}): concentration "
+            f"{concentration:.2f} < {MIN_SIGNATURE_CONCENTRATION} ({effect(effect_id).signature})"], concentration

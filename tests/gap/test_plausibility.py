@@ -1,0 +1,40 @@
+"""Plausibility (issue 14, item 4): a fit that needs parameters at the limit of their physical range, or
+whose improvement does not sit where its signature says, is rejected with a reason."""
+import numpy as np
+
+from model.gap.plausibility import MIN_SIGNATURE_CONCENTRATION, range_reasons, signature_reasons
+from model.gap.sample_features import SampleFeatures
+
+
+def features(articulation_deg):
+    n = len(articulation_deg)
+    return SampleFeatures(np.asarray(articulation_deg, dtype=float), np.zeros(n), np.full(n, 80.0),
+                          np.array(["static"] * n), np.zeros(n), np.linspace(1.0, 5.0, n), np.linspace(0, 1, n),
+                          np.zeros(n, dtype=int))
+
+
+def test_a_fit_at_the_limit_of_its_physical_range_is_implausible():
+    assert range_reasons("gravity", (0.0, -9.81, 0.0)) == []
+    reasons = range_reasons("gravity", (0.0, -20.0, 0.0))         # 2 g, the range's end
+    assert len(reasons) == 1 and "g_y_m_s2" in reasons[0] and "limit" in reasons[0]
+    assert range_reasons("backlash", (0.0,)) == []                 # 0 is 'off', not a limit
+
+
+def test_gravity_that_only_improves_bent_samples_does_not_match_its_signature():
+    """Sag is present at zero load: a 'gravity' fit whose gain lies only where the catheter is bent
+    absorbs something else."""
+    f = features([0.0] * 50 + [90.0] * 50)
+    before = np.ones((100, 3))
+    after_bent_only = before.copy()
+    after_bent_only[50:] *= 0.5
+    reasons, concentration = signature_reasons("gravity", f, before, after_bent_only)
+    assert concentration == 0.0 and reasons and "zero load" in reasons[0]
+    after_everywhere = 0.5 * before
+    reasons, concentration = signature_reasons("gravity", f, before, after_everywhere)
+    assert reasons == [] and concentration >= MIN_SIGNATURE_CONCENTRATION
+
+
+def test_lumen_compression_along_the_whole_catheter_is_not_near_the_base():
+    assert range_reasons("lumen_compression", (0.03, 20.0), flexible_length_mm=100.0) == []
+    reasons = range_reasons("lumen_compression", (0.01, 181.0), flexible_length_mm=100.0)
+    assert len(reasons) == 1 and "flexible length" in reasons[0]
