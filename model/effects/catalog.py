@@ -83,6 +83,7 @@ EFFECTS: dict[str, CandidateEffect] = {e.id: e for e in (
         param_names=("compliance_mm_per_n", "time_s"), typical=(0.05, 0.3), lower=(0.0, 0.01), upper=(0.5, 5.0),
         signature="the tip trails fast motion (error along the motion, growing with speed) and keeps creeping "
                   "without overshoot for ~tau after each stop; slow motion and settled holds agree",
+        signature_region="fast",
         apply=lambda t, v: t.replace(drive_creep_mm_per_n=v[0], drive_creep_time_s=v[1])),
 )}
 
