@@ -9,7 +9,8 @@ import signal
 import sys
 
 from crest.cli import (bench_command, demo_command, estop_command, excite_command, fit_command, gap_command,
-                       home_command, jog_command, move_command, paper_command, run_command, status_command)
+                       home_command, jog_command, move_command, paper_command, run_command, status_command,
+                       view_command)
 from crest.config import ConfigError
 from crest.driver import SafetyStop
 from crest.exit_codes import ExitCode
@@ -27,6 +28,7 @@ COMMANDS = {
     "bench": bench_command,
     "fit": fit_command,
     "gap": gap_command,
+    "view": view_command,
 }
 
 

@@ -8,6 +8,7 @@ from control import make_controller
 from crest.cli.common_options import (add_controller_options, add_record_option, add_testbed_options,
                                       catheter_params, motion_plan, record_path, session_options)
 from crest.cli.progress import ProgressBar
+from crest.cli.view_option import add_view_option, view_for
 from crest.config import load_testbed_config
 from crest.driver.motion_limits import check_trajectory
 from crest.experiment.builtin_trajectories import BUILTINS, BuiltinOptions, builtin_trajectory
@@ -27,6 +28,7 @@ def add_parser(sub) -> None:
     add_controller_options(parser)
     add_record_option(parser)
     add_testbed_options(parser)
+    add_view_option(parser)
     parser.set_defaults(handler=run)
 
 
@@ -48,12 +50,15 @@ def _run_builtin(args, config) -> int:
     trajectory = builtin_trajectory(name, workspace, limits, options, period_s, plan.start)   # refused before motion
     controller = make_controller(args.controller, workspace, limits, period_s,
                                  loss_timeout_s=config.tracker.loss_timeout_s)
-    with open_session(session_options(args)) as session:
+    with view_for(args, config, params) as view, open_session(session_options(args)) as session:
+        view.attach(session)
         session.testbed.home()
         recorder = _recorder(session, args, params, f"builtin:{name} with {args.controller}")
         progress = ProgressBar(len(trajectory), f"{args.trajectory} ({args.controller})")
+        on_cycle = view.follow(f"run {args.trajectory}, controller {args.controller}", trajectory.tip_mm,
+                               len(trajectory), progress.update)
         result = run_with_controller(session, trajectory, controller, recorder=recorder,
-                                     closed_loop=args.controller == "dahl+fb", on_cycle=progress.update)
+                                     closed_loop=args.controller == "dahl+fb", on_cycle=on_cycle)
         progress.finish()
         if recorder:
             recorder.close({"rms_tip_error_mm": result.rms_tip_error_mm})
@@ -65,10 +70,12 @@ def _run_csv(args, config) -> int:
     samples = read_setpoints(args.trajectory, config.sync.period_s)
     check_trajectory(config, samples)                 # refused before anything moves
     params = catheter_params(args)
-    with open_session(session_options(args)) as session:
+    with view_for(args, config, params) as view, open_session(session_options(args)) as session:
+        view.attach(session)
         session.testbed.home()
         recorder = _recorder(session, args, params, f"set-points {args.trajectory}", tip_ref=False)
         progress = ProgressBar(len(samples), args.trajectory)
+        on_cycle = view.follow(f"run set-points {args.trajectory}", None, len(samples), progress.update)
         done = [0]
 
         def on_sample(sample):
@@ -76,7 +83,7 @@ def _run_csv(args, config) -> int:
             tip = session.tracker.latest() if session.tracker else None
             if recorder:
                 recorder.write(sample, tip.tip_mm if tip is not None else None)
-            progress.update(done[0])
+            on_cycle(done[0])
 
         session.testbed.run_trajectory(samples, on_sample=on_sample)
         progress.finish()
