@@ -19,6 +19,9 @@ FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-
          "--disable-background-networking", "--disable-component-update", "--disable-sync",
          "--disable-dev-shm-usage", "--window-size=1200,1000")
 
+SCRIPT_TIMEOUT_S = 120.0
+"""Page loads and scripts may take long on a loaded machine; a hang still ends."""
+
 
 class BrowserMissing(RuntimeError):
     """No headless browser here; the message says what to install."""
@@ -53,6 +56,8 @@ def headless_chromium() -> Iterator:
     options.add_argument(f"--user-data-dir={profile}")
     try:
         driver = webdriver.Chrome(service=Service(executable_path=str(CHROMEDRIVER)), options=options)
+        driver.set_script_timeout(SCRIPT_TIMEOUT_S)
+        driver.set_page_load_timeout(SCRIPT_TIMEOUT_S)
         try:
             yield driver
         finally:

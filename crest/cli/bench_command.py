@@ -7,12 +7,12 @@ import sys
 from pathlib import Path
 
 from control.benchmark import controller_cycle_times
-from crest.bench import model_bench, stack_bench
+from crest.bench import model_bench, stack_bench, view_bench
 from crest.bench.machine_info import machine_info
 from crest.gap.benchmark import diagnosis_time
 from model import CatheterParams
 
-SECTIONS = ("model", "scaling", "move", "controllers", "full_stack", "gap")
+SECTIONS = ("model", "scaling", "move", "controllers", "full_stack", "gap", "view")
 
 
 def add_parser(sub) -> None:
@@ -22,6 +22,8 @@ def add_parser(sub) -> None:
                         help="run only these sections")
     parser.add_argument("--stack-seconds", type=float, default=60.0,
                         help="duration of the full-stack run at 500 Hz SYNC (default 60)")
+    parser.add_argument("--view-seconds", type=float, default=20.0,
+                        help="duration of each control-loop run without and with the live view (default 20)")
     parser.set_defaults(handler=run)
 
 
@@ -36,6 +38,7 @@ def run(args: argparse.Namespace) -> int:
         "full_stack": lambda: {f"{rate:.0f}_hz": stack_bench.full_stack(rate, args.stack_seconds)
                                for rate in (500.0, 250.0)},
         "gap": lambda: diagnosis_time(),
+        "view": lambda: view_bench.control_loop_with_and_without_view(args.view_seconds),
     }
     for name in args.only:
         if name not in steps:
@@ -75,6 +78,12 @@ def format_table(results: dict) -> str:
         r = results["gap"]
         seconds = r["seconds"]
         rows.append(("Gap diagnosis of a 10-min, 100 Hz log", f"{seconds:.0f} s", "<= 60 s", seconds <= 60.0))
+    if "view" in results:
+        r = results["view"]
+        for key, label in (("without_view", "no view"), ("with_view", f"live view, client: {r['client']}")):
+            c = r[key]
+            rows.append((f"Control loop cycle, {label}", f"median {c['median_ms']:.2f} ms, p99 {c['p99_ms']:.2f} ms, "
+                         f"{c['late_cycles']} late of {c['cycles']}", f"{c['nominal_ms']:g} ms nominal", None))
     lines = ["| measure | result | goal | met |", "|---|---|---|---|"]
     for name, value, goal, met in rows:
         lines.append(f"| {name} | {value} | {goal} | {'-' if met is None else ('yes' if met else 'NO')} |")

@@ -61,7 +61,7 @@ class ReplayState:
         tip = log.tip_mm[i] if np.all(np.isfinite(log.tip_mm[i])) else None
         recent = (log.t_s > log.t_s[i] - TRAIL_S) & (log.t_s <= log.t_s[i]) & log.tip_valid
         window = np.flatnonzero((log.t_s > log.t_s[i] - TENSION_WINDOW_S) & (log.t_s <= log.t_s[i]))
-        window = window[::max(1, len(window) // TENSION_POINTS)]
+        window = np.unique(np.append(window[::max(1, len(window) // TENSION_POINTS)], i))   # the row shown last
         tensions = log.tendon_force_n[window] if log.tendon_force_n is not None else np.empty((0, 4))
         tip_error = None
         if tip is not None and log.tip_ref_mm is not None and np.all(np.isfinite(log.tip_ref_mm[i])):
