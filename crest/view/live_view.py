@@ -30,11 +30,11 @@ from crest.view.live_state import SCREEN_PERIOD_S, LiveState
 from crest.view.page import ESTOP_REASON, Page
 from crest.view.view_server import ViewServer
 
-LINGER_S = 3.0
+LINGER_S = 5.0
 """Longest the view keeps serving after the session ended, for an open page to show the end."""
 
-FLUSH_S = 0.3
-"""Time for the last frame's websocket message to leave after it was handed to Bokeh."""
+FLUSH_S = 1.0
+"""Time for the last frame's websocket message to reach a slow browser after it was handed to Bokeh."""
 
 
 class LiveView:

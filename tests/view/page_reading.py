@@ -59,7 +59,7 @@ def button(driver, label: str):
     return driver.execute_script(FIND_BUTTON_JS, label)
 
 
-def wait_for(condition, timeout_s: float, what: str, poll_s: float = 0.25):
+def wait_for(condition, timeout_s: float, what: str, poll_s: float = 0.5):
     """The first truthy value of ``condition()`` within ``timeout_s``; AssertionError naming ``what``."""
     deadline = time.monotonic() + timeout_s
     while True:

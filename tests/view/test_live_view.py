@@ -142,6 +142,7 @@ def test_estop_button_stops_the_run_with_its_cause_in_the_log(live_run, live_pag
     estop = wait_for(lambda: button(browser, "E-STOP"), PAGE_TIMEOUT_S, "the E-STOP button")
     wait_for(lambda: "cycles (" in visible_text(browser), PAGE_TIMEOUT_S, "the run to be going")
     estop.click()
+    wait_for(lambda: "E-STOP sent" in visible_text(browser), PAGE_TIMEOUT_S, "the page to say the E-STOP was sent")
     assert live_run.process.wait(EXIT_TIMEOUT_S) == ExitCode.INTERRUPTED
     live_run.stop()
     assert "E-STOP button in the live view" in live_run.stderr
@@ -149,4 +150,3 @@ def test_estop_button_stops_the_run_with_its_cause_in_the_log(live_run, live_pag
     assert "E-STOP button in the live view" in summary["stop_cause"]
     assert summary["exit_code"] == ExitCode.INTERRUPTED
     assert summary["samples"] > 0
-    assert "E-STOP sent" in visible_text(browser)        # the page said what the click did
