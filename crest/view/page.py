@@ -46,7 +46,8 @@ class Page:
         self.tensions = ColumnDataSource(dict(t=[], **{f"tension{k}": [] for k in range(1, 5)}), name="tensions")
         projections = [self._projection(name, h, v, extent_mm) for name, h, v in PROJECTIONS]
         self.tension_plot = figure(title="tendon tension [N]", width=560, height=300, x_axis_label="t [s]",
-                                   y_axis_label="N", name="tension_plot", tools="", toolbar_location=None)
+                                   y_axis_label="N", name="tension_plot", tools="", toolbar_location=None,
+                                   y_range=Range1d(0.0, 1.0))
         for k, color in enumerate(TENDON_COLORS, start=1):
             self.tension_plot.line("t", f"tension{k}", source=self.tensions, color=color, line_width=2,
                                    legend_label=f"tendon{k}")
@@ -98,6 +99,9 @@ class Page:
             self.reference.data = _xyz(frame.reference_mm)
         self.tensions.data = dict(t=frame.tension_t_s, **{f"tension{k + 1}": frame.tension_n[:, k] for k in range(4)})
         self.limit.location = frame.max_tension_n
+        highest_n = max(frame.max_tension_n, float(np.max(frame.tension_n, initial=0.0)))
+        if np.isfinite(highest_n):
+            self.tension_plot.y_range.end = 1.1 * highest_n      # the limit line stays in sight
         tip_error = "unknown" if frame.tip_error_mm is None else f"{frame.tip_error_mm:.2f} mm"
         notes = "".join(f"<br>{html.escape(note)}" for note in frame.notes)
         self.status.text = (f"<b>{html.escape(frame.status)}</b> &nbsp; t = {frame.t_s:.2f} s &nbsp; "
