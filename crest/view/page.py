@@ -97,7 +97,7 @@ class Page:
         self.trail.data = _xyz(frame.trail_mm)
         if len(self.reference.data["x"]) != len(frame.reference_mm):
             self.reference.data = _xyz(frame.reference_mm)
-        self.tensions.data = dict(t=frame.tension_t_s, **{f"tension{k + 1}": frame.tension_n[:, k] for k in range(4)})
+        self._show_tensions(frame.tension_t_s, frame.tension_n)
         self.limit.location = frame.max_tension_n
         highest_n = max(frame.max_tension_n, float(np.max(frame.tension_n, initial=0.0)))
         if np.isfinite(highest_n):
@@ -110,6 +110,19 @@ class Page:
         self.stop.text = "" if frame.stop is None else (
             "<div style='background:#b00;color:white;font-size:18px;padding:8px'>"
             f"{html.escape(frame.stop.describe())}</div>")
+
+
+    def _show_tensions(self, t_s: np.ndarray, tension_n: np.ndarray) -> None:
+        """Send only the samples newer than the page has (the window rolls), else the whole window."""
+        shown_t_s = self.tensions.data["t"]
+        last_s = float(shown_t_s[-1]) if len(shown_t_s) else None
+        if last_s is not None and len(t_s) and t_s[0] <= last_s <= t_s[-1]:
+            new = t_s > last_s
+            if new.any():
+                self.tensions.stream(dict(t=t_s[new], **{f"tension{k + 1}": tension_n[new, k] for k in range(4)}),
+                                     rollover=len(t_s))
+            return
+        self.tensions.data = dict(t=t_s, **{f"tension{k + 1}": tension_n[:, k] for k in range(4)})
 
 
 def _xyz(points: np.ndarray) -> dict[str, np.ndarray]:
