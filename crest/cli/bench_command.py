@@ -7,12 +7,12 @@ import sys
 from pathlib import Path
 
 from control.benchmark import controller_cycle_times
-from crest.bench import model_bench, plant_bench, stack_bench
+from crest.bench import model_bench, plant_bench, stack_bench, view_bench
 from crest.bench.machine_info import machine_info
 from crest.gap.benchmark import diagnosis_time
 from model import CatheterParams
 
-SECTIONS = ("model", "dynamic", "scaling", "move", "controllers", "rod_plant", "full_stack", "gap")
+SECTIONS = ("model", "dynamic", "scaling", "move", "controllers", "rod_plant", "full_stack", "gap", "view")
 
 
 def add_parser(sub) -> None:
@@ -22,6 +22,10 @@ def add_parser(sub) -> None:
                         help="run only these sections")
     parser.add_argument("--stack-seconds", type=float, default=60.0,
                         help="duration of the full-stack run at 500 Hz SYNC (default 60)")
+    parser.add_argument("--view-seconds", type=float, default=20.0,
+                        help="duration of each control-loop run without and with the live view (default 20)")
+    parser.add_argument("--view-realtime", action="store_true",
+                        help="view section: pace the loop in real time instead of running it back to back")
     parser.set_defaults(handler=run)
 
 
@@ -38,6 +42,8 @@ def run(args: argparse.Namespace) -> int:
         "full_stack": lambda: {f"{rate:.0f}_hz": stack_bench.full_stack(rate, args.stack_seconds)
                                for rate in (500.0, 250.0)},
         "gap": lambda: diagnosis_time(),
+        "view": lambda: view_bench.control_loop_with_and_without_view(
+            args.view_seconds, realtime=args.view_realtime),
     }
     for name in args.only:
         if name not in steps:
@@ -87,6 +93,14 @@ def format_table(results: dict) -> str:
         r = results["gap"]
         seconds = r["seconds"]
         rows.append(("Gap diagnosis of a 10-min, 100 Hz log", f"{seconds:.0f} s", "<= 60 s", seconds <= 60.0))
+    if "view" in results:
+        r = results["view"]
+        for key, label in (("without_view", "no view"), ("with_view_no_client", "live view, no page open"),
+                           ("with_view", f"live view, client: {r['client']}")):
+            c = r[key]
+            rows.append((f"Control loop cycle ({r['clock']}), {label}",
+                         f"median {c['median_ms']:.2f} ms, p99 {c['p99_ms']:.2f} ms, {c['late_cycles']} of "
+                         f"{c['cycles']} over 1.5 SYNC periods", f"SYNC period {c['sync_period_ms']:g} ms", None))
     lines = ["| measure | result | goal | met |", "|---|---|---|---|"]
     for name, value, goal, met in rows:
         lines.append(f"| {name} | {value} | {goal} | {'-' if met is None else ('yes' if met else 'NO')} |")

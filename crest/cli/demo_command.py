@@ -13,6 +13,7 @@ from pathlib import Path
 from control import make_controller
 from crest.cli.common_options import add_testbed_options, motion_plan, session_options
 from crest.cli.progress import ProgressBar
+from crest.cli.view_option import add_view_option, view_for
 from crest.experiment.builtin_trajectories import BuiltinOptions, builtin_trajectory
 from crest.experiment.controlled_run import run_with_controller
 from crest.experiment.recorder import ExperimentRecorder
@@ -27,6 +28,7 @@ def add_parser(sub) -> None:
     parser.add_argument("--catheter", type=Path, default=None, help="the controller's catheter parameters TOML")
     parser.add_argument("--record", type=Path, default=Path("runs"), help="directory for the logs (default runs/)")
     add_testbed_options(parser)
+    add_view_option(parser)
     parser.set_defaults(handler=run)
 
 
@@ -37,7 +39,8 @@ def run(args: argparse.Namespace) -> int:
     trajectory = builtin_trajectory("circle", workspace, limits, options, period_s, plan.start)
     out_dir = args.record / f"demo-{time.strftime('%Y%m%d-%H%M%S')}"
     results = {}
-    with open_session(session_options(args)) as session:
+    with view_for(args, config, params) as view, open_session(session_options(args)) as session:
+        view.attach(session)
         where = "the virtual testbed" if session.backend.is_virtual else "the testbed"
         print(f"booted 5 axes on {where} ({config.bus.interface}:{config.bus.channel}, "
               f"SYNC {1 / period_s:.0f} Hz)")
@@ -49,8 +52,9 @@ def run(args: argparse.Namespace) -> int:
             recorder = ExperimentRecorder(session, out_dir / f"circle-{name}.csv", params,
                                           source=f"crest demo, circle with {name}")
             progress = ProgressBar(len(trajectory), f"circle with {name:<5}")
-            result = run_with_controller(session, trajectory, controller, recorder=recorder,
-                                         on_cycle=progress.update)
+            on_cycle = view.follow(f"demo: circle with {name}", trajectory.tip_mm, len(trajectory),
+                                   progress.update)
+            result = run_with_controller(session, trajectory, controller, recorder=recorder, on_cycle=on_cycle)
             progress.finish()
             recorder.close({"rms_tip_error_mm": result.rms_tip_error_mm})
             results[name] = result

@@ -22,6 +22,8 @@ from control.tension_governor import TensionGovernor
 from crest.cli.common_options import (add_record_option, add_testbed_options, catheter_params, record_path,
                                       session_options)
 from crest.cli.keyboard import Keyboard
+from crest.cli.view_option import add_view_option, view_for
+from crest.config import load_testbed_config
 from crest.driver import AXIS_ORDER, AxisTargets
 from crest.experiment.recorder import ExperimentRecorder
 from crest.experiment.workspace_from_config import workspace_for
@@ -40,6 +42,7 @@ def add_parser(sub) -> None:
     parser = sub.add_parser("jog", help="jog pitch, yaw, insertion or one axis from the keyboard")
     add_record_option(parser)
     add_testbed_options(parser)
+    add_view_option(parser)
     parser.set_defaults(handler=run)
 
 
@@ -166,7 +169,11 @@ class JogGovernor:
 def run(args: argparse.Namespace) -> int:
     params = catheter_params(args)
     status_open = False
-    with open_session(session_options(args)) as session, Keyboard() as keyboard:
+    config = load_testbed_config(args.config)
+    with view_for(args, config, params) as view, open_session(session_options(args)) as session, \
+            Keyboard() as keyboard:
+        view.attach(session)
+        view.follow("jog from the keyboard")
         try:
             testbed = session.testbed
             testbed.home()

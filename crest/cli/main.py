@@ -9,7 +9,8 @@ import signal
 import sys
 
 from crest.cli import (bench_command, demo_command, estop_command, excite_command, fit_command, gap_command,
-                       home_command, jog_command, move_command, paper_command, run_command, status_command)
+                       home_command, jog_command, move_command, paper_command, run_command, status_command,
+                       view_command)
 from crest.cli.library_logging import route_library_logging
 from crest.config import ConfigError
 from crest.driver import SafetyStop, Terminated
@@ -28,6 +29,7 @@ COMMANDS = {
     "bench": bench_command,
     "fit": fit_command,
     "gap": gap_command,
+    "view": view_command,
 }
 
 

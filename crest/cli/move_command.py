@@ -11,6 +11,7 @@ from control.trajectories import point_to_point
 from crest.cli.common_options import (add_controller_options, add_record_option, add_testbed_options, motion_plan,
                                       record_path, session_options)
 from crest.driver import AxisTargets
+from crest.cli.view_option import add_view_option, view_for
 from crest.experiment.controlled_run import run_with_controller
 from crest.experiment.planned_tension import check_planned_tension
 from crest.experiment.recorder import ExperimentRecorder
@@ -28,6 +29,7 @@ def add_parser(sub) -> None:
     add_controller_options(parser)
     add_record_option(parser)
     add_testbed_options(parser)
+    add_view_option(parser)
     parser.set_defaults(handler=run)
 
 
@@ -46,12 +48,15 @@ def run(args: argparse.Namespace) -> int:
                           "lower the articulation or lengthen the free length with --insertion MM")
     controller = make_controller(args.controller, workspace, limits, config.sync.period_s,
                                  loss_timeout_s=config.tracker.loss_timeout_s)
-    with open_session(session_options(args)) as session:
+    with view_for(args, config, params) as view, open_session(session_options(args)) as session:
+        view.attach(session)
         session.testbed.home()
         path = record_path(args.record, "move")
         recorder = ExperimentRecorder(session, path, params, source=f"move with {args.controller}") if path else None
+        on_cycle = view.follow(f"move to pitch {args.pitch:g} deg, yaw {args.yaw:g} deg, controller "
+                               f"{args.controller}", trajectory.tip_mm, len(trajectory))
         run_with_controller(session, trajectory, controller, recorder=recorder,
-                            closed_loop=args.controller == "dahl+fb")
+                            closed_loop=args.controller == "dahl+fb", on_cycle=on_cycle)
         tip = session.tracker.latest() if session.tracker else None
         if recorder:
             recorder.close()

@@ -8,6 +8,7 @@ from control import make_controller
 from crest.cli.common_options import (add_controller_options, add_record_option, add_testbed_options,
                                       catheter_params, motion_plan, record_path, session_options)
 from crest.cli.progress import ProgressBar
+from crest.cli.view_option import add_view_option, view_for
 from crest.config import load_testbed_config
 from crest.driver import AxisTargets
 from crest.driver.motion_limits import check_trajectory
@@ -30,6 +31,7 @@ def add_parser(sub) -> None:
     add_controller_options(parser)
     add_record_option(parser)
     add_testbed_options(parser)
+    add_view_option(parser)
     parser.set_defaults(handler=run)
 
 
@@ -56,14 +58,17 @@ def _run_builtin(args, config) -> int:
                           "lower --articulation-deg or lengthen the free length with --insertion-mm")
     controller = make_controller(args.controller, workspace, limits, period_s,
                                  loss_timeout_s=config.tracker.loss_timeout_s)
-    with open_session(session_options(args)) as session:
+    with view_for(args, config, params) as view, open_session(session_options(args)) as session:
+        view.attach(session)
         session.testbed.home()
         session.testbed.move_to(start_targets)        # out to the scenario's free length
         recorder = _recorder(session, args, params, f"builtin:{name} with {args.controller}")
         progress = ProgressBar(len(trajectory), f"{args.trajectory} ({args.controller})")
+        on_cycle = view.follow(f"run {args.trajectory}, controller {args.controller}", trajectory.tip_mm,
+                               len(trajectory), progress.update)
         try:
             result = run_with_controller(session, trajectory, controller, recorder=recorder,
-                                         closed_loop=args.controller == "dahl+fb", on_cycle=progress.update)
+                                         closed_loop=args.controller == "dahl+fb", on_cycle=on_cycle)
             progress.finish()
         finally:
             progress.close()
@@ -80,10 +85,12 @@ def _run_csv(args, config) -> int:
     home = AxisTargets.from_pulls(0.0, 0.0, config.insertion_axis.home_position_mm, config.coordination.pretension_mm)
     check_planned_tension(config, params, home, [s.tendon_mm for s in samples], [s.insertion_mm for s in samples],
                           args.trajectory, "lower the pulls in the file or lengthen its free length (insertion_cmd)")
-    with open_session(session_options(args)) as session:
+    with view_for(args, config, params) as view, open_session(session_options(args)) as session:
+        view.attach(session)
         session.testbed.home()
         recorder = _recorder(session, args, params, f"set-points {args.trajectory}", tip_ref=False)
         progress = ProgressBar(len(samples), args.trajectory)
+        on_cycle = view.follow(f"run set-points {args.trajectory}", None, len(samples), progress.update)
         feed = session.tip_feed()
         coverage = TipCoverage(config.tracker.loss_timeout_s if session.tracker is not None else None)
 
@@ -93,7 +100,7 @@ def _run_csv(args, config) -> int:
             if recorder:
                 recorder.write(sample, tip)
             coverage.add(sample.t_s, tip is not None)
-            progress.update(coverage.rows)
+            on_cycle(coverage.rows)
 
         try:
             session.testbed.run_trajectory(samples, on_sample=on_sample)

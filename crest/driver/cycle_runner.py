@@ -84,6 +84,7 @@ class CycleRunner:
         self.stop_callbacks: list[Callable[[SafetyStop], None]] = []
         self.safety_stop: SafetyStop | None = None
         self.last_sample: CycleSample | None = None
+        self.cycle_observers: list[Callable[[CycleSample], None]] = []
         self._ramp_time_s = max(axis.config.max_velocity_mm_s / axis.config.max_acceleration_mm_s2
                                 for axis in self.axes)
 
@@ -106,6 +107,8 @@ class CycleRunner:
             fresh=fresh,
             limited=tuple(limited),
         )
+        for observe in self.cycle_observers:
+            observe(self.last_sample)
         return self.last_sample
 
     def _check(self, now_s: float, fresh: tuple[bool, ...], latched: list[int | None]) -> None:

@@ -86,6 +86,11 @@ def tracker_cause(age_s: float, limit_s: float) -> StopCause:
                                                        "during a closed-loop run; check the sensor and its cable")
 
 
+def operator_cause(reason: str) -> StopCause:
+    """An operator's stop that is not Ctrl-C (e.g. the live view's E-STOP button); same exit code."""
+    return StopCause(ExitCode.INTERRUPTED, None, reason)
+
+
 def exception_cause(error: BaseException) -> StopCause:
     """The cause for an exception that ends a driver call or a ``with Testbed`` block."""
     if isinstance(error, Terminated):

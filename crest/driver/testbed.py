@@ -47,7 +47,7 @@ from crest.driver.heartbeat_producer import HeartbeatProducer
 from crest.driver.identity import DriveIdentity
 from crest.driver.motion_limits import SetPointLimiter, check_positions, check_trajectory
 from crest.driver.safety_monitor import ErrorFrameListener, SafetyMonitor
-from crest.driver.stop_causes import emcy_text, tracker_cause
+from crest.driver.stop_causes import emcy_text, operator_cause, tracker_cause
 from crest.driver.sync_cycle import SyncCycle
 from crest.driver.synchronized_move import AxisProfile, synchronized_move
 
@@ -187,6 +187,19 @@ class Testbed:
     def report_tracker_loss(self, age_s: float) -> None:
         """Tracker loss in a closed-loop run (any thread): quick-stop now; the next call raises SafetyStop."""
         self._monitor.trip(tracker_cause(age_s, self.config.tracker.loss_timeout_s))
+
+    def operator_stop(self, reason: str) -> None:
+        """An operator's stop from any thread (the live view's E-STOP): every axis quick-stops now,
+        and the loop's next call finishes the stop like Ctrl-C does (exit code INTERRUPTED, ``reason``)."""
+        self._monitor.trip(operator_cause(reason))
+
+    def observe_cycles(self, observer: Callable[[CycleSample], None]) -> None:
+        """Hand every supervised cycle's sample to ``observer``, in the control loop's thread.
+
+        The observer must return at once: no I/O, no lock held by another thread for long
+        (the live view appends to a bounded deque and does its work in its own thread).
+        """
+        self._runner.cycle_observers.append(observer)
 
     def watch_tracker(self, sample_age_s: Callable[[], float | None] | None) -> None:
         """Check every cycle that ``sample_age_s()`` (s since the last valid tip sample, None: none
