@@ -7,10 +7,11 @@ from pathlib import Path
 
 import numpy as np
 
+from configs import CONFIG_DIR
 from model import CatheterParams, DahlCatheter, EffectTerms
 from model.effects import combined_terms
 
-DEFAULT_PLANT_TOML = Path(__file__).resolve().parents[2] / "configs" / "virtual_plant.toml"
+DEFAULT_PLANT_TOML = CONFIG_DIR / "virtual_plant.toml"
 
 
 class PlantConfigError(ValueError):
