@@ -12,7 +12,7 @@ import math
 import sys
 
 from control import Articulation, tendons_from_articulation
-from crest.cli.common_options import (add_record_option, add_testbed_options, catheter_params, record_path,
+from crest.cli.common_options import (add_record_option, add_testbed_options, catheter_params, planned_record_path,
                                       session_options)
 from crest.cli.keyboard import Keyboard
 from crest.driver import AXIS_ORDER, AxisTargets
@@ -94,13 +94,14 @@ class JogState:
 
 def run(args: argparse.Namespace) -> int:
     params = catheter_params(args)
+    path = planned_record_path(args, "jog")
     with open_session(session_options(args)) as session, Keyboard() as keyboard:
         testbed = session.testbed
         testbed.home()
         workspace = workspace_for(session.config, params)
         state = JogState(workspace, testbed.positions().insertion_mm, session.config.coordination.pretension_mm)
-        path = record_path(args.record, "jog")
-        recorder = ExperimentRecorder(session, path, params, source="jog", tip_ref=False) if path else None
+        recorder = (ExperimentRecorder(session, path, params, source="jog", tip_ref=False, overwrite=args.overwrite)
+                    if path else None)
         feed = session.tip_feed()
         print(__doc__.split("\n\n")[1], file=sys.stderr)
         cycles = 0

@@ -9,7 +9,7 @@ import numpy as np
 from control import articulation_from_pitch_yaw, make_controller
 from control.trajectories import point_to_point
 from crest.cli.common_options import (add_controller_options, add_record_option, add_testbed_options, motion_plan,
-                                      record_path, session_options)
+                                      planned_record_path, session_options)
 from crest.experiment.controlled_run import run_with_controller
 from crest.experiment.recorder import ExperimentRecorder
 from crest.session import open_session
@@ -29,7 +29,16 @@ def add_parser(sub) -> None:
     parser.set_defaults(handler=run)
 
 
+def _check_target(args: argparse.Namespace) -> None:
+    for flag, value, unit in (("--pitch", args.pitch, "degrees"), ("--yaw", args.yaw, "degrees"),
+                              ("--insertion", args.insertion, "mm of free length")):
+        if value is not None and not math.isfinite(value):
+            raise ValueError(f"{flag} {value}: give a finite number of {unit}")
+
+
 def run(args: argparse.Namespace) -> int:
+    _check_target(args)
+    path = planned_record_path(args, "move")
     plan = motion_plan(args)
     config, params, workspace, limits, start = plan.config, plan.params, plan.workspace, plan.limits, plan.start
     insertion = args.insertion if args.insertion is not None else start.insertion_mm
@@ -42,8 +51,8 @@ def run(args: argparse.Namespace) -> int:
                                  loss_timeout_s=config.tracker.loss_timeout_s)
     with open_session(session_options(args)) as session:
         session.testbed.home()
-        path = record_path(args.record, "move")
-        recorder = ExperimentRecorder(session, path, params, source=f"move with {args.controller}") if path else None
+        recorder = (ExperimentRecorder(session, path, params, source=f"move with {args.controller}",
+                                       overwrite=args.overwrite) if path else None)
         run_with_controller(session, trajectory, controller, recorder=recorder,
                             closed_loop=args.controller == "dahl+fb")
         tip = session.tracker.latest() if session.tracker else None
