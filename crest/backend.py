@@ -53,6 +53,14 @@ class Backend:
             self.virtual.stop()
 
 
+def fault_kinds() -> dict[str, tuple[str, ...]]:
+    """The virtual testbed's fault kinds, for `--fault` help: {'drive': kinds, 'tracker': kinds}."""
+    from sim_backend.faults import DRIVE_FAULT_KINDS, TRACKER_FAULT_KINDS
+
+    return {"drive": tuple(sorted(kind.value for kind in DRIVE_FAULT_KINDS)),
+            "tracker": tuple(sorted(kind.value for kind in TRACKER_FAULT_KINDS))}
+
+
 def open_backend(config: TestbedConfig, *, plant: str | None = None, plant_config: Path | None = None,
                  faults: Sequence[str] = (), effects: dict | None = None, realtime: bool = True,
                  plant_in_thread: bool = False, tracker_noise_mm: float | None = None,

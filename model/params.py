@@ -12,7 +12,9 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-DEFAULT_CATHETER_TOML = Path(__file__).resolve().parents[1] / "configs" / "catheter.toml"
+from configs import CONFIG_DIR
+
+DEFAULT_CATHETER_TOML = CONFIG_DIR / "catheter.toml"
 
 # TOML table of each field: the file groups fields by topic.
 _SECTIONS = {

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from control.benchmark import controller_cycle_times
 from crest.bench import model_bench, plant_bench, stack_bench, view_bench
+from crest.cli.common_options import check_output
 from crest.bench.machine_info import machine_info
 from crest.gap.benchmark import diagnosis_time
 from model import CatheterParams
@@ -30,6 +31,8 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    path = Path(args.json_path)
+    check_output(path)                                             # refused now, not after the benchmarks
     params = CatheterParams.from_toml()
     results: dict = {"machine": machine_info()}
     steps = {
@@ -50,7 +53,7 @@ def run(args: argparse.Namespace) -> int:
             continue
         print(f"crest bench: {name} ...", file=sys.stderr, flush=True)
         results[name] = steps[name]()
-    path = Path(args.json_path)
+    path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(results, indent=2))
     print(format_table(results))
     print(f"results written to {path}")

@@ -2,16 +2,20 @@
 from __future__ import annotations
 
 import argparse
+import math
+import os
+from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 
-from dataclasses import dataclass
-
 from control import CONTROLLER_NAMES, Articulation, MotionLimits, Workspace
+from crest.backend import fault_kinds
 from crest.config import TestbedConfig, load_testbed_config
+from crest.config.testbed_config import INSERTION_AXIS_NAME, TENDON_AXIS_NAMES
 from crest.experiment.workspace_from_config import limits_for, workspace_for
 from crest.session import SessionOptions
 from model import CatheterParams
+from model.effects import EFFECTS
 
 
 def add_testbed_options(parser: argparse.ArgumentParser) -> None:
@@ -22,17 +26,92 @@ def add_testbed_options(parser: argparse.ArgumentParser) -> None:
                        help="virtual testbed: the plant behind the drives (default: the Dahl catheter)")
     group.add_argument("--plant-config", type=Path, default=None, metavar="PLANT.toml",
                        help="virtual testbed: the Dahl catheter's description (default configs/virtual_plant.toml)")
-    group.add_argument("--fault", action="append", default=[], metavar="AXIS:KIND@SECONDS",
-                       help="virtual testbed: inject a fault, e.g. tendon3:emcy@2.0 or tracker:disconnect@1.5")
-    group.add_argument("--effect", action="append", default=[], metavar="ID[:NAME=VALUE,...]",
-                       help="virtual testbed: switch on an unmodelled effect in the plant, e.g. backlash:width_mm=0.4")
+    group.add_argument("--fault", action="append", default=[], metavar="AXIS:KIND@SECONDS", help=_fault_help())
+    group.add_argument("--effect", action="append", default=[], metavar="ID[:NAME=VALUE,...]", help=_effect_help())
     group.add_argument("--fast", action="store_true",
                        help="virtual testbed: run in simulated time, as fast as this computer allows")
+
+
+def _fault_help() -> str:
+    kinds = fault_kinds()
+    axes = ", ".join((*TENDON_AXIS_NAMES, INSERTION_AXIS_NAME))
+    return (f"virtual testbed: inject a fault, e.g. tendon3:emcy@2.0 or tracker:disconnect@1.5 (repeatable). "
+            f"AXIS is {axes} (kinds {', '.join(kinds['drive'])}) or tracker (kinds {', '.join(kinds['tracker'])}). "
+            "SECONDS counts from the moment the virtual testbed powers up, before boot and homing, "
+            "not from the start of the trajectory")
+
+
+def _effect_help() -> str:
+    effects = "; ".join(f"{effect.id} ({', '.join(effect.param_names)})" for effect in EFFECTS.values())
+    return (f"virtual testbed: switch on an unmodelled effect in the plant, e.g. backlash:width_mm=0.4 "
+            f"(repeatable; unset parameters take their typical value). IDs (parameters): {effects}")
+
+
+def add_debug_option(parser: argparse.ArgumentParser, default=argparse.SUPPRESS) -> None:
+    """--debug, accepted before and after the command (a subcommand's copy must not reset the main one)."""
+    parser.add_argument("--debug", action="store_true", default=default, help="show Python tracebacks on errors")
+
+
+def add_overwrite_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--overwrite", action="store_true", help="replace output files that already exist")
 
 
 def add_record_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--record", type=Path, default=None, metavar="PATH",
                         help="record the run: a .csv log path, or a directory for a time-stamped log")
+    add_overwrite_option(parser)
+
+
+def positive_number(text: str) -> float:
+    """argparse type: a finite number > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}")
+    return value
+
+
+def check_output(path: Path | None, overwrite: bool = True, *, directory: bool = False) -> None:
+    """Refuse, before anything opens or moves, an output that could only fail at the end.
+
+    A file that exists is refused unless `overwrite`; so is a path whose nearest existing folder is
+    a file or cannot be written (missing folders are created when the output is written).
+    `directory` paths are folders the command writes into.
+    """
+    if path is None:
+        return
+    path = Path(path)
+    if path.exists():
+        if directory and not path.is_dir():
+            raise ValueError(f"{path} is a file; give a folder to write into")
+        if not directory and path.is_dir():
+            raise ValueError(f"{path} is a folder; give a file path")
+        if not directory and not overwrite:
+            raise ValueError(f"{path} exists; pass --overwrite to replace it, or choose another path")
+    folder = path if directory else path.parent
+    folder = folder.absolute()
+    while not folder.exists():
+        folder = folder.parent
+    if not folder.is_dir():
+        raise ValueError(f"cannot write {path}: {folder} is a file, not a folder")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise ValueError(f"cannot write {path}: no permission to write in {folder}")
+
+
+def check_log_outputs(csv_path: Path | None, overwrite: bool) -> None:
+    """A log's three files (CSV, JSON sidecar, CAN traffic .blf) checked as in `check_output`."""
+    if csv_path is not None:
+        for suffix in (".csv", ".json", ".blf"):
+            check_output(csv_path.with_suffix(suffix), overwrite)
+
+
+def planned_record_path(args: argparse.Namespace, stem: str) -> Path | None:
+    """`--record` resolved (see `record_path`) and checked before anything opens or moves."""
+    path = record_path(args.record, stem)
+    check_log_outputs(path, args.overwrite)
+    return path
 
 
 def add_controller_options(parser: argparse.ArgumentParser, default: str = "cc") -> None:

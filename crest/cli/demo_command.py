@@ -11,7 +11,7 @@ import time
 from pathlib import Path
 
 from control import make_controller
-from crest.cli.common_options import add_testbed_options, motion_plan, session_options
+from crest.cli.common_options import add_testbed_options, check_output, motion_plan, session_options
 from crest.cli.progress import ProgressBar
 from crest.cli.view_option import add_view_option, view_for
 from crest.experiment.builtin_trajectories import BuiltinOptions, builtin_trajectory
@@ -33,6 +33,7 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_output(args.record, directory=True)                      # refused before anything moves
     plan = motion_plan(args)
     config, params, workspace, limits, period_s = plan.config, plan.params, plan.workspace, plan.limits, plan.period_s
     options = BuiltinOptions(articulation_deg=DEMO_ARTICULATION_DEG, insertion_mm=DEMO_INSERTION_MM)

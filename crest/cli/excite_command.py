@@ -10,7 +10,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from crest.cli.common_options import add_testbed_options, catheter_params, session_options
+from crest.cli.common_options import (add_overwrite_option, add_testbed_options, catheter_params, check_log_outputs,
+                                      check_output, session_options)
 from crest.cli.progress import ProgressBar
 from crest.config import load_testbed_config
 from crest.experiment.excitation_run import plan_excitation, record_excitation
@@ -20,6 +21,7 @@ from crest.session import open_session
 def add_parser(sub) -> None:
     parser = sub.add_parser("excite", help="record the training and held-out excitation logs for fit and gap")
     parser.add_argument("--record", type=Path, required=True, metavar="DIR", help="directory for the two logs")
+    add_overwrite_option(parser)
     parser.add_argument("--short", action="store_true", help="the short excitation (about 95 s + 65 s)")
     parser.add_argument("--catheter", type=Path, default=None, help="catheter parameters TOML (geometry)")
     add_testbed_options(parser)
@@ -30,6 +32,9 @@ def run(args: argparse.Namespace) -> int:
     config = load_testbed_config(args.config)
     params = catheter_params(args)
     plan = plan_excitation(config, params, short=args.short)      # refused before anything moves
+    check_output(args.record, directory=True)
+    for name in plan.logs:
+        check_log_outputs(args.record / f"{name}.csv", args.overwrite)
     bars: dict[str, ProgressBar] = {}
 
     def on_cycle(name: str, done: int, total: int) -> None:
@@ -37,7 +42,7 @@ def run(args: argparse.Namespace) -> int:
         bar.update(done)
 
     with open_session(session_options(args)) as session:
-        results = record_excitation(session, plan, args.record, params, on_cycle)
+        results = record_excitation(session, plan, args.record, params, on_cycle, overwrite=args.overwrite)
     for name, result in results.items():
         lost = result.tip_coverage.loss_sentence()
         print(f"wrote {result.log_path} ({result.cycles} cycles, a tip in {result.tip_samples}"

@@ -6,6 +6,7 @@ import json
 import sys
 from pathlib import Path
 
+from crest.cli.common_options import check_output
 from crest.gap.log_diagnosis import calibrate_logs, prior_catheter
 from model.gap.diagnosis import DiagnosisSettings
 
@@ -28,6 +29,8 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_output(args.out)                                         # refused now, not after the fit
+    check_output(args.json_path)
     fit = calibrate_logs(args.train, args.catheter, DiagnosisSettings(),
                          progress=lambda message: print(f"crest fit: {message}", file=sys.stderr, flush=True),
                          fit_dynamics=DYNAMICS_CHOICES[args.dynamics])
@@ -40,8 +43,10 @@ def run(args: argparse.Namespace) -> int:
               "# tendon zero offsets (mm, subtract from the drive position): "
               + ", ".join(f"{z:+.5f}" for z in fit.zero_offsets_mm)]
     header += [f"# FLAG: {flag}" for flag in fit.flags]
+    args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text("\n".join(header) + "\n" + fitted.to_toml())
     if args.json_path:
+        args.json_path.parent.mkdir(parents=True, exist_ok=True)
         args.json_path.write_text(json.dumps(fit.as_dict(), indent=2))
     print(f"{'parameter':<24} {'value':>12} {'std':>10}")
     for name, value, std in zip(fit.names, fit.values, fit.std):

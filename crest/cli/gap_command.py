@@ -10,6 +10,7 @@ import json
 import sys
 from pathlib import Path
 
+from crest.cli.common_options import check_output
 from crest.gap.blind_benchmark import run_blind_benchmark
 from crest.gap.log_diagnosis import diagnose_logs
 from crest.gap.log_recordings import load_recordings
@@ -44,6 +45,9 @@ def _progress(message: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_output(args.json_path)                                   # refused now, not after the diagnosis
+    check_output(args.report, directory=True)
+    check_output(args.work_dir, directory=True)
     settings = DiagnosisSettings(workers=args.workers)
     if args.blind_benchmark:
         if args.train or args.holdout:
@@ -74,6 +78,7 @@ def _write_json(result: dict, path: Path | None) -> None:
         tree, nulls = finite_tree(result)
         if nulls:
             tree["non_finite"] = list(tree.get("non_finite") or []) + nulls
+        path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(json.dumps(tree, indent=2, allow_nan=False))
         print(f"results written to {path}")
 
@@ -100,8 +105,12 @@ def format_score(score: dict) -> str:
         return "-" if value is None else f"{100 * value:.0f} %"
 
     shrink = score["shrink_error_pp"] or {}
+    counts = score["counts"]
+    skipped = [f"{counts[key]} {label}" for key, label in (("skipped", "skipped"), ("no_result", "without a result"))
+               if counts.get(key)]
     return "\n".join([
-        f"blind benchmark, {score['cases']} cases ({score['counts']})",
+        f"blind benchmark, {score['cases']} cases: {counts['single']} with one effect, {counts['pair']} with two, "
+        f"{counts['none']} clean" + (f" ({', '.join(skipped)})" if skipped else ""),
         f"top-1 on single effects: {pct(score['top1_single'])} (target >= 90 %); on the "
         f"{score['counts']['single'] - score['counts']['single_below_noise']} whose effect moves the tip by more "
         f"than the tracker noise: {pct(score['top1_single_above_noise'])}",

@@ -19,7 +19,7 @@ import numpy as np
 from control import Articulation, tendons_from_articulation
 from control.path_tension import DEFAULT_TENSION_MARGIN, forecast_path_tension
 from control.tension_governor import TensionGovernor
-from crest.cli.common_options import (add_record_option, add_testbed_options, catheter_params, record_path,
+from crest.cli.common_options import (add_record_option, add_testbed_options, catheter_params, planned_record_path,
                                       session_options)
 from crest.cli.keyboard import Keyboard
 from crest.cli.view_option import add_view_option, view_for
@@ -169,6 +169,7 @@ class JogGovernor:
 def run(args: argparse.Namespace) -> int:
     params = catheter_params(args)
     status_open = False
+    path = planned_record_path(args, "jog")
     config = load_testbed_config(args.config)
     with view_for(args, config, params) as view, open_session(session_options(args)) as session, \
             Keyboard() as keyboard:
@@ -181,8 +182,8 @@ def run(args: argparse.Namespace) -> int:
             pretension_mm = session.config.coordination.pretension_mm
             state = JogState(workspace, testbed.positions().insertion_mm, pretension_mm)
             governor = JogGovernor(params, session.config, pretension_mm)
-            path = record_path(args.record, "jog")
-            recorder = ExperimentRecorder(session, path, params, source="jog", tip_ref=False) if path else None
+            recorder = (ExperimentRecorder(session, path, params, source="jog", tip_ref=False,
+                                           overwrite=args.overwrite) if path else None)
             feed = session.tip_feed()
             print(__doc__.split("\n\n")[1], file=sys.stderr)
             sample = testbed.cycle()

@@ -11,6 +11,8 @@ import sys
 from crest.cli import (bench_command, demo_command, estop_command, excite_command, fit_command, gap_command,
                        home_command, jog_command, move_command, paper_command, run_command, status_command,
                        view_command)
+from crest.cli.common_options import add_debug_option
+from crest.cli.compile_notice import announce_compiles
 from crest.cli.library_logging import route_library_logging
 from crest.config import ConfigError
 from crest.driver import SafetyStop, Terminated
@@ -35,10 +37,12 @@ COMMANDS = {
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="crest", description="CREST catheter testbed: driver, model, control.")
-    parser.add_argument("--debug", action="store_true", help="show Python tracebacks on errors")
+    add_debug_option(parser, default=False)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name, module in COMMANDS.items():
         module.add_parser(sub)
+    for command_parser in sub.choices.values():      # `crest run ... --debug` as well as `crest --debug run ...`
+        add_debug_option(command_parser)
     return parser
 
 
@@ -59,6 +63,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     route_library_logging(args.debug)
+    announce_compiles()
     try:
         return int(args.handler(args))
     except SafetyStop as stop:

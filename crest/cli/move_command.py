@@ -9,9 +9,9 @@ import numpy as np
 from control import articulation_from_pitch_yaw, make_controller
 from control.trajectories import point_to_point
 from crest.cli.common_options import (add_controller_options, add_record_option, add_testbed_options, motion_plan,
-                                      record_path, session_options)
-from crest.driver import AxisTargets
+                                      planned_record_path, session_options)
 from crest.cli.view_option import add_view_option, view_for
+from crest.driver import AxisTargets
 from crest.experiment.controlled_run import run_with_controller
 from crest.experiment.planned_tension import check_planned_tension
 from crest.experiment.recorder import ExperimentRecorder
@@ -33,7 +33,16 @@ def add_parser(sub) -> None:
     parser.set_defaults(handler=run)
 
 
+def _check_target(args: argparse.Namespace) -> None:
+    for flag, value, unit in (("--pitch", args.pitch, "degrees"), ("--yaw", args.yaw, "degrees"),
+                              ("--insertion", args.insertion, "mm of free length")):
+        if value is not None and not math.isfinite(value):
+            raise ValueError(f"{flag} {value}: give a finite number of {unit}")
+
+
 def run(args: argparse.Namespace) -> int:
+    _check_target(args)
+    path = planned_record_path(args, "move")
     plan = motion_plan(args)
     config, params, workspace, limits, start = plan.config, plan.params, plan.workspace, plan.limits, plan.start
     insertion = args.insertion if args.insertion is not None else start.insertion_mm
@@ -51,8 +60,8 @@ def run(args: argparse.Namespace) -> int:
     with view_for(args, config, params) as view, open_session(session_options(args)) as session:
         view.attach(session)
         session.testbed.home()
-        path = record_path(args.record, "move")
-        recorder = ExperimentRecorder(session, path, params, source=f"move with {args.controller}") if path else None
+        recorder = (ExperimentRecorder(session, path, params, source=f"move with {args.controller}",
+                                       overwrite=args.overwrite) if path else None)
         on_cycle = view.follow(f"move to pitch {args.pitch:g} deg, yaw {args.yaw:g} deg, controller "
                                f"{args.controller}", trajectory.tip_mm, len(trajectory))
         run_with_controller(session, trajectory, controller, recorder=recorder,

@@ -5,6 +5,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from crest.cli.common_options import check_output
 from crest.paper import SUMMARY, PaperSettings, reproduce
 from model import CatheterParams
 
@@ -18,6 +19,7 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_output(args.out, directory=True)                         # refused now, not after the figures
     params = CatheterParams.from_toml(args.catheter) if args.catheter else CatheterParams.from_toml()
     summary = reproduce(args.out, PaperSettings(params, n_elements=args.elements), progress=sys.stderr)
     headline = summary["headline"]

@@ -19,6 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from configs import CONFIG_DIR
+
 TENDON_AXIS_NAMES = ("tendon1", "tendon2", "tendon3", "tendon4")
 INSERTION_AXIS_NAME = "insertion"
 AXIS_KINDS = ("tendon", "insertion")
@@ -218,8 +220,8 @@ def _jsonable(value: Any) -> Any:
 
 
 def default_config_path() -> Path:
-    """configs/testbed.toml of the source tree that holds the crest package."""
-    return Path(__file__).resolve().parents[2] / "configs" / "testbed.toml"
+    """The packaged configs/testbed.toml (the virtual testbed), in the source tree or an installed wheel."""
+    return CONFIG_DIR / "testbed.toml"
 
 
 def load_testbed_config(path: Path | str | None = None) -> TestbedConfig:
@@ -473,12 +475,21 @@ def _parse_axis(entry: _Table, defaults: _Table | None) -> AxisConfig:
 
 
 def _eds_path(table: _Table, raw: Any, *, key: str) -> Path:
+    """The EDS named by `raw`: absolute, or relative to the TOML's folder.
+
+    A testbed TOML copied elsewhere without its EDS still finds the packaged EDS of the same file
+    name (configs/crest_drive.eds); anything else must exist where the TOML says.
+    """
     if not isinstance(raw, str) or not raw:
         raise table.fail(key, f"expected the EDS file name (relative to the config file), got {_describe(raw)}")
     eds_path = (table.path.parent / raw).resolve()
-    if not eds_path.is_file():
-        raise table.fail(key, f"EDS file {eds_path} does not exist; give a path relative to {table.path.name}")
-    return eds_path
+    if eds_path.is_file():
+        return eds_path
+    packaged = CONFIG_DIR / Path(raw).name
+    if not Path(raw).is_absolute() and packaged.is_file():
+        return packaged
+    raise table.fail(key, f"EDS file {eds_path} does not exist; give its path relative to {table.path.name} "
+                          f"or an absolute one, e.g. eds = \"/path/to/{Path(raw).name}\"")
 
 
 def _soft_limits(table: _Table, raw: Any) -> tuple[float, float]:

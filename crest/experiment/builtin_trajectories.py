@@ -20,7 +20,7 @@ class BuiltinOptions:
     articulation_deg: float = 90.0
     plane_deg: float = 0.0
     insertion_mm: float | None = None    # free length of sweep/history/circle, or insertion's target
-    periods: float = 1.0                 # sweeps, circle turns
+    periods: float = 1.0                 # sweeps (a whole number), circle turns (> 0)
     circle_period_s: float = 8.0
 
 
@@ -42,6 +42,10 @@ def builtin_start(name: str, workspace: Workspace, options: BuiltinOptions) -> A
 def builtin_trajectory(name: str, workspace: Workspace, limits: MotionLimits, options: BuiltinOptions,
                        period_s: float, start: Articulation) -> Trajectory:
     """The trajectory `name` from `start`; bad options raise TrajectoryError before anything moves."""
+    if not (math.isfinite(options.periods) and options.periods > 0):
+        raise ValueError(f"periods must be a number > 0 (sweeps or circle turns), got {options.periods!r}")
+    if name == "sweep" and options.periods != int(options.periods):
+        raise ValueError(f"builtin:sweep runs whole sweeps; periods must be a whole number, got {options.periods!r}")
     theta = math.radians(options.articulation_deg)
     plane = math.radians(options.plane_deg)
     common = dict(period_s=period_s, start=start)
@@ -50,7 +54,7 @@ def builtin_trajectory(name: str, workspace: Workspace, limits: MotionLimits, op
                                  velocity_rad_s=ARTICULATION_VELOCITY_RAD_S,
                                  acceleration_rad_s2=ARTICULATION_ACCELERATION_RAD_S2, hold_s=0.5, back=True,
                                  **common)
-        return one.repeated(max(1, round(options.periods)))
+        return one.repeated(int(options.periods))
     if name == "circle":
         return circle(workspace, limits, articulation_rad=theta, circle_period_s=options.circle_period_s,
                       turns=options.periods, start_plane_rad=plane, insertion_mm=options.insertion_mm,

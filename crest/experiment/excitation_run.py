@@ -47,20 +47,22 @@ def plan_excitation(config: TestbedConfig, params: CatheterParams, short: bool =
 
 
 def record_excitation(session: Session, plan: ExcitationPlan, folder: Path, params: CatheterParams,
-                      on_cycle: Callable[[str, int, int], None] | None = None) -> dict[str, RunResult]:
+                      on_cycle: Callable[[str, int, int], None] | None = None, *,
+                      overwrite: bool = False) -> dict[str, RunResult]:
     """Home, then for each planned log: move to its start, condition, and run and log it to
     folder/<name>.csv.
 
     on_cycle(name, done, total) is called after every cycle of every run (the conditioning's as
-    "<name> conditioning"). Returns each log's result (cycles, cycles with a tip, tracker loss, log path);
-    each log's summary holds its rows with and without a tip and the tracker loss, if any.
+    "<name> conditioning"); overwrite replaces existing logs. Returns each log's result (cycles,
+    cycles with a tip, tracker loss, log path); each log's summary holds its rows with and without a
+    tip and the tracker loss, if any.
     """
     session.testbed.home()
     results = {}
     for name, trajectory in plan.logs.items():
         _run(session, plan.conditioning, None, f"{name} conditioning", on_cycle)
         recorder = ExperimentRecorder(session, Path(folder) / f"{name}.csv", params, source=f"crest excite: {name}",
-                                      notes=NOTES)
+                                      notes=NOTES, overwrite=overwrite)
         results[name] = _run(session, trajectory, recorder, name, on_cycle)
         recorder.close()
     return results

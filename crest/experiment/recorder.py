@@ -25,7 +25,7 @@ class ExperimentRecorder:
     """Writes one row per SYNC cycle to `<path>.csv` and the bus to `<path>.blf`."""
 
     def __init__(self, session: Session, csv_path: Path, catheter: CatheterParams, *, source: str,
-                 notes: str = "", tip_ref: bool = True):
+                 notes: str = "", tip_ref: bool = True, overwrite: bool = False):
         csv_path = Path(csv_path)
         csv_path.parent.mkdir(parents=True, exist_ok=True)
         config = session.config
@@ -35,7 +35,7 @@ class ExperimentRecorder:
                                              outer_diameter_mm=catheter.outer_diameter_mm),
             sample_rate_hz=1.0 / config.sync.period_s, tendon_force=True, tip_ref=tip_ref,
             source=f"crest {__version__}, {'virtual testbed' if session.backend.is_virtual else 'hardware'}: {source}",
-            notes=notes, config=config.as_dict())
+            notes=notes, config=config.as_dict(), overwrite=overwrite)
         self.bus_log_path = csv_path.with_suffix(".blf")
         self.bus = BusRecorder(self.bus_log_path)
         monitor = session.backend.monitor_bus()

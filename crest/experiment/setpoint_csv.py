@@ -30,9 +30,17 @@ def read_setpoints(path: Path | str, period_s: float) -> list[AxisTargets]:
                 raise SetpointFileError(f"{path}: missing column(s) {', '.join(missing)}; "
                                         f"a set-point file needs {', '.join(COLUMNS)}")
             rows = []
-            for line, row in enumerate(reader, start=2):
+            for row in reader:
+                line = reader.line_num
+                if None in row:
+                    raise SetpointFileError(f"{path}, line {line}: {len(reader.fieldnames) + len(row[None])} cells, "
+                                            f"but the header names {len(reader.fieldnames)} columns")
                 values = []
                 for column in COLUMNS:
+                    if row[column] is None:
+                        cells = sum(value is not None for value in row.values())
+                        raise SetpointFileError(f"{path}, line {line}, column {column!r}: the row ends before this "
+                                                f"column ({cells} cells, the header names {len(reader.fieldnames)})")
                     try:
                         value = float(row[column])
                     except (TypeError, ValueError):

@@ -40,7 +40,7 @@ def calibrate_logs(train: Sequence[Path | str], catheter_toml: Path | str | None
     with ProcessPoolExecutor(settings.workers) if settings.workers > 1 else nullcontext() as pool:
         return calibrate_base(recordings, prior, resolution=settings.resolution,
                               max_iterations=settings.baseline_iterations, executor=pool,
-                              on_fit=lambda done, total: say(f"fit: {done}/{total} starts fitted"),
+                              on_fit=lambda done, total: say(f"base model: {done}/{total} starts fitted"),
                               fit_dynamics=fit_dynamics)
 
 

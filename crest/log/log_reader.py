@@ -74,6 +74,8 @@ def read_log(csv_path: Path | str) -> ExperimentLog:
     A last line without its newline (a killed writer) is dropped with a TruncatedLogWarning.
     """
     path = Path(csv_path)
+    if not path.is_file():
+        raise LogFormatError(path, "no such file" if not path.exists() else "not a file (a crest log is a .csv file)")
     sidecar = _read_sidecar(path)
     columns, rows = _read_rows(path)
     by_name = {name: position for position, name in enumerate(columns)}

@@ -156,7 +156,8 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
         best = eligible[0]
         # second effects: the next best singles that are found on their own
         others = [r.effects[0] for r in eligible[1:settings.pair_candidates + 1]]
-        say(f"pairs: {best.effects[0]} alone (control) and with each of {', '.join(others) or 'no other'}")
+        say(f"pairs: {best.effects[0]} alone (control) and with each of {', '.join(others)}" if others else
+            f"pairs: no second effect is found on its own; refitting {best.effects[0]} alone (control)")
         continued, *pairs = run_tasks([task(dict(best.fit.effects), best.fit, CONTINUE)]
                                       + [task({**best.fit.effects, other: start_values(other)}, best.fit, PROBE)
                                          for other in others], pool)

@@ -7,11 +7,12 @@ from pathlib import Path
 
 import numpy as np
 
+from configs import CONFIG_DIR
 from model import CatheterParams, DahlCatheter, EffectTerms
 from model.dahl_catheter import MAX_DYNAMIC_SAMPLE_S
 from model.effects import combined_terms
 
-DEFAULT_PLANT_TOML = Path(__file__).resolve().parents[2] / "configs" / "virtual_plant.toml"
+DEFAULT_PLANT_TOML = CONFIG_DIR / "virtual_plant.toml"
 
 
 class PlantConfigError(ValueError):

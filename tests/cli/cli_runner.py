@@ -10,12 +10,15 @@ CREST = [sys.executable, "-m", "crest.cli.main"]
 REPO = Path(__file__).resolve().parents[2]
 
 
-def crest(*args: str, timeout_s: float = 240.0, cwd: Path | None = None) -> subprocess.CompletedProcess:
-    env = dict(os.environ, PYTHONUNBUFFERED="1")
+def crest(*args: str, timeout_s: float = 240.0, cwd: Path | None = None,
+          env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
+    """Run crest to the end; env adds to (or overrides) this process's environment."""
+    env = dict(os.environ, PYTHONUNBUFFERED="1", **(env or {}))
     return subprocess.run([*CREST, *args], capture_output=True, text=True, timeout=timeout_s,
                           cwd=cwd or REPO, env=env)
 
 
-def start_crest(*args: str, cwd: Path | None = None, **kwargs) -> subprocess.Popen:
-    env = dict(os.environ, PYTHONUNBUFFERED="1")
+def start_crest(*args: str, cwd: Path | None = None, env: dict[str, str] | None = None,
+                **kwargs) -> subprocess.Popen:
+    env = dict(os.environ, PYTHONUNBUFFERED="1", **(env or {}))
     return subprocess.Popen([*CREST, *args], cwd=cwd or REPO, env=env, **kwargs)

@@ -173,6 +173,16 @@ def test_eds_is_resolved_relative_to_the_config_file(tmp_path: Path, data: dict)
     data["axis_defaults"]["insertion"]["eds"] = "drives/other.eds"
     config = parse_testbed_config(data, elsewhere / "testbed.toml")
     assert config.insertion_axis.eds_path == (elsewhere / "drives" / "other.eds").resolve()
-    (elsewhere / "crest_drive.eds").unlink()
-    with pytest.raises(ConfigError, match=r"axis_defaults\.tendon\.eds: EDS file .*elsewhere/crest_drive\.eds"):
+    (elsewhere / "drives" / "other.eds").unlink()
+    with pytest.raises(ConfigError, match=r"axis_defaults\.insertion\.eds: EDS file .*elsewhere/drives/other\.eds "
+                                          r"does not exist.*eds = \"/path/to/other\.eds\""):
         parse_testbed_config(data, elsewhere / "testbed.toml")
+
+
+def test_a_copied_config_without_its_eds_finds_the_packaged_eds(tmp_path: Path):
+    """The README's recipe: copy testbed.toml elsewhere and edit it; the shipped EDS is not copied."""
+    shutil.copy(SHIPPED, tmp_path / "testbed.toml")
+    config = load_testbed_config(tmp_path / "testbed.toml")
+    assert config.axis("tendon1").eds_path == (SHIPPED.parent / "crest_drive.eds").resolve()
+    (tmp_path / "crest_drive.eds").write_text("[FileInfo]\n")          # an EDS beside the copy wins
+    assert load_testbed_config(tmp_path / "testbed.toml").axis("tendon1").eds_path == tmp_path / "crest_drive.eds"
