@@ -95,8 +95,8 @@ def test_a_setpoint_file_refuses_builtin_options(tmp_path, option, value):
 
 
 def test_a_builtin_refuses_an_option_it_does_not_use():
-    stderr = assert_refused_before_boot(crest("run", "builtin:sweep", "--insertion-mm", "40", "--fast"))
-    assert "--insertion-mm does not apply to builtin:sweep" in stderr
+    stderr = assert_refused_before_boot(crest("run", "builtin:history", "--periods", "2", "--fast"))
+    assert "--periods does not apply to builtin:history" in stderr
 
 
 def test_nan_pitch_is_refused_in_the_units_the_user_typed():
