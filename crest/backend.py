@@ -42,6 +42,12 @@ class Backend:
             return None
         return can.Bus(interface="virtual", channel=self.virtual.channel)
 
+    def start_fault_clock(self) -> None:
+        """The virtual testbed's --fault times count from now (the start of the run's motion);
+        no-op on hardware."""
+        if self.virtual is not None:
+            self.virtual.start_fault_clock()
+
     def tick(self, now_s: float) -> None:
         """Advance the simulator's time-based duties (deterministic use); no-op on hardware."""
         if self.virtual is not None:
@@ -123,7 +129,7 @@ def _open_virtual(config: TestbedConfig, plant_spec: str | None, plant_toml: Pat
     # The virtual bus is in-process: a channel of our own per testbed keeps testbeds apart.
     channel = f"{config.bus.channel}-{os.getpid()}-{next(_channel_numbers)}"
     testbed = VirtualTestbed(specs, channel, plant, bitrate_bit_s=config.bus.bitrate,
-                             sync_period_s=config.sync.period_s, faults=faults,
+                             sync_period_s=config.sync.period_s, faults=faults, faults_wait_for_run=True,
                              tracker=TrackerSettings(
                                  tracker.noise_mm if tracker_noise_mm is None else tracker_noise_mm,
                                  tracker.dropout if tracker_dropout is None else tracker_dropout,

@@ -28,6 +28,11 @@ class Session:
     tracker: AuroraDriver | None
     realtime: bool = True
 
+    def start_fault_clock(self) -> None:
+        """The virtual testbed's --fault times count from now: called where a command's motion
+        starts (a run's trajectory, the jog loop, homing for `crest home`). The first call counts."""
+        self.backend.start_fault_clock()
+
     def tip_feed(self) -> TipFeed:
         """Tip samples on the loop's clock (paced to the tracker rate when time is simulated)."""
         return TipFeed(self.tracker, None if self.realtime else 1.0 / TRACKER_RATE_HZ)

@@ -36,10 +36,11 @@ class SimDriveSet:
 
     :param bitrate_bit_s, sync_period_s: the bus and SYNC timing the bus load is measured against.
     :param faults: per-axis faults to inject at their time; tracker faults are ignored here.
+    :param faults_held: their clock waits for ``start_fault_clock`` (see ``FaultSchedule``).
     """
 
     def __init__(self, specs: Sequence[DriveSpec], channel: str, *, bitrate_bit_s: int = 1_000_000,
-                 sync_period_s: float = 0.01, faults: Iterable[FaultSpec] = ()) -> None:
+                 sync_period_s: float = 0.01, faults: Iterable[FaultSpec] = (), faults_held: bool = False) -> None:
         _check_unique(specs)
         self.channel = channel
         self.drives: dict[str, SimDrive] = {spec.name: SimDrive(spec) for spec in specs}
@@ -48,7 +49,7 @@ class SimDriveSet:
             if fault.axis not in self.drives:
                 raise ValueError(f"fault {fault}: no drive named {fault.axis!r}; "
                                  f"drives are {', '.join(self.drives)}")
-        self._schedule = FaultSchedule(drive_faults)
+        self._schedule = FaultSchedule(drive_faults, held=faults_held)
         self.sync_period_s = sync_period_s
         self._sync_listeners: list[Callable[[int, bytearray, float], None]] = []
         self.bus_load = BusLoadMeter(bitrate_bit_s, sync_period_s)
@@ -102,6 +103,9 @@ class SimDriveSet:
 
     def __exit__(self, *exc_info) -> None:
         self.stop()
+
+    def start_fault_clock(self, now_s: float) -> None:
+        self._schedule.start_clock(now_s)
 
     def tick(self, now_s: float) -> None:
         """Time-based duties at ``now_s`` (s since start): scheduled faults, heartbeats, watchdogs."""

@@ -1,7 +1,9 @@
 """Fault injection specifications: ``AXIS:KIND@SECONDS``.
 
 Examples: ``tendon3:emcy@2.0``, ``insertion:heartbeat@1.0``, ``tracker:disconnect@1.5``.
-SECONDS is the time since the virtual testbed started. Per-axis kinds (for any
+SECONDS is the time since the fault clock started: the virtual testbed's start, or, for a testbed
+built with ``faults_wait_for_run=True`` (the crest CLI's), the moment the host starts the run's
+motion (``VirtualTestbed.start_fault_clock``). Per-axis kinds (for any
 axis name except ``tracker``):
 
     emcy          the drive faults with EMCY 0x2310 (continuous over current)
@@ -91,14 +93,27 @@ def parse_fault(text: str) -> FaultSpec:
 
 
 class FaultSchedule:
-    """Faults waiting for their time; ``due(now_s)`` hands each one out once."""
+    """Faults waiting for their time; ``due(now_s)`` hands each one out once.
 
-    def __init__(self, faults: tuple[FaultSpec, ...] | list[FaultSpec]) -> None:
+    A fault at ``at_s`` is due when ``now_s >= clock_zero_s + at_s``. The clock starts at 0 (the
+    testbed's start) unless the schedule is ``held``: then nothing is due until ``start_clock(now_s)``
+    sets ``clock_zero_s = now_s`` (once; later calls keep the first zero).
+    """
+
+    def __init__(self, faults: tuple[FaultSpec, ...] | list[FaultSpec], held: bool = False) -> None:
         self._waiting = sorted(faults, key=lambda fault: fault.at_s)
+        self._clock_zero_s: float | None = None if held else 0.0
+
+    def start_clock(self, now_s: float) -> None:
+        if self._clock_zero_s is None:
+            self._clock_zero_s = float(now_s)
 
     def due(self, now_s: float) -> list[FaultSpec]:
-        ready = [fault for fault in self._waiting if fault.at_s <= now_s]
-        self._waiting = [fault for fault in self._waiting if fault.at_s > now_s]
+        if self._clock_zero_s is None:
+            return []
+        elapsed_s = now_s - self._clock_zero_s
+        ready = [fault for fault in self._waiting if fault.at_s <= elapsed_s]
+        self._waiting = [fault for fault in self._waiting if fault.at_s > elapsed_s]
         return ready
 
     @property

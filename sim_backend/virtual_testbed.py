@@ -42,7 +42,7 @@ class VirtualTestbed:
     def __init__(self, drive_specs: Sequence[DriveSpec], channel: str, plant: Plant, *,
                  bitrate_bit_s: int = 1_000_000, sync_period_s: float = 0.01,
                  tracker: TrackerSettings = TrackerSettings(), faults: Sequence[FaultSpec] = (),
-                 plant_in_thread: bool = False):
+                 faults_wait_for_run: bool = False, plant_in_thread: bool = False):
         names = {spec.name for spec in drive_specs}
         missing = set(TENDON_AXES + (INSERTION_AXIS,)) - names
         if missing:
@@ -50,8 +50,8 @@ class VirtualTestbed:
         self.channel = channel
         self.sync_period_s = sync_period_s
         self.drives = SimDriveSet(drive_specs, channel, bitrate_bit_s=bitrate_bit_s,
-                                  sync_period_s=sync_period_s, faults=faults)
-        self._tracker_faults = FaultSchedule([f for f in faults if f.targets_tracker])
+                                  sync_period_s=sync_period_s, faults=faults, faults_held=faults_wait_for_run)
+        self._tracker_faults = FaultSchedule([f for f in faults if f.targets_tracker], held=faults_wait_for_run)
         self.plant_runner = PlantRunner(plant, self._tendon_positions_mm(), self._insertion_position_mm())
         self.plant_in_thread = plant_in_thread
         self.tracker = SimTracker(self._tracker_tip, noise_mm=tracker.noise_mm, dropout=tracker.dropout,
@@ -60,6 +60,7 @@ class VirtualTestbed:
         self._ticker: threading.Thread | None = None
         self._stop = threading.Event()
         self._started_s = 0.0
+        self._now_s = 0.0          # the last tick's time (s since start)
 
     # -- life cycle ---------------------------------------------------------------------------
     def start(self, realtime: bool = False) -> "VirtualTestbed":
@@ -96,8 +97,15 @@ class VirtualTestbed:
         return self.tracker.port_name
 
     # -- time ---------------------------------------------------------------------------------
+    def start_fault_clock(self) -> None:
+        """Scheduled faults count from now (the last tick), when the testbed was built with
+        faults_wait_for_run; the first call counts, later ones change nothing."""
+        self.drives.start_fault_clock(self._now_s)
+        self._tracker_faults.start_clock(self._now_s)
+
     def tick(self, now_s: float) -> None:
         """Time-based duties at now_s (s since start): drive heartbeats and watchdogs, faults."""
+        self._now_s = now_s
         self.drives.tick(now_s)
         for fault in self._tracker_faults.due(now_s):
             self.tracker.inject(fault.kind.value)

@@ -25,7 +25,8 @@ def add_testbed_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--plant", default=None, metavar="MODULE:CLASS",
                        help="virtual testbed: the plant behind the drives (default: the Dahl catheter)")
     group.add_argument("--plant-config", type=Path, default=None, metavar="PLANT.toml",
-                       help="virtual testbed: the Dahl catheter's description (default configs/virtual_plant.toml)")
+                       help="virtual testbed: the plant description (default configs/virtual_plant.toml, the Dahl "
+                            "catheter; configs/rod_plant.toml, with family = \"rod\", the independent rod plant)")
     group.add_argument("--fault", action="append", default=[], metavar="AXIS:KIND@SECONDS", help=_fault_help())
     group.add_argument("--effect", action="append", default=[], metavar="ID[:NAME=VALUE,...]", help=_effect_help())
     group.add_argument("--fast", action="store_true",
@@ -37,8 +38,8 @@ def _fault_help() -> str:
     axes = ", ".join((*TENDON_AXIS_NAMES, INSERTION_AXIS_NAME))
     return (f"virtual testbed: inject a fault, e.g. tendon3:emcy@2.0 or tracker:disconnect@1.5 (repeatable). "
             f"AXIS is {axes} (kinds {', '.join(kinds['drive'])}) or tracker (kinds {', '.join(kinds['tracker'])}). "
-            "SECONDS counts from the moment the virtual testbed powers up, before boot and homing, "
-            "not from the start of the trajectory")
+            "SECONDS counts from the start of the command's motion: the trajectory of run, move, demo "
+            "and excite (after boot, homing and the move to the start), the jog loop, homing for home")
 
 
 def _effect_help() -> str:

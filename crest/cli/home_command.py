@@ -16,6 +16,7 @@ def add_parser(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     with open_session(session_options(args, tracker=False)) as session:
+        session.start_fault_clock()
         session.testbed.home()
         print(format_status(session.testbed.status()))
         print("homed: tendons at their pretension, insertion at its home position")

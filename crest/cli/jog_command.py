@@ -186,6 +186,7 @@ def run(args: argparse.Namespace) -> int:
                                            overwrite=args.overwrite) if path else None)
             feed = session.tip_feed()
             print(__doc__.split("\n\n")[1], file=sys.stderr)
+            session.start_fault_clock()
             sample = testbed.cycle()
             cycles = 0
             while True:

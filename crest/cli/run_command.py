@@ -145,6 +145,7 @@ def _run_csv(args, config) -> int:
             on_cycle(coverage.rows)
 
         try:
+            session.start_fault_clock()
             session.testbed.run_trajectory(samples, on_sample=on_sample)
             progress.finish()
         finally:

@@ -17,6 +17,9 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.fault:
+        raise ValueError("--fault does not apply to status: it moves nothing, and fault times count from the "
+                         "start of a command's motion (use it with run, move, jog, home, demo or excite)")
     with open_session(session_options(args, boot=False, tracker=False)) as session:
         time.sleep(HEARTBEAT_WAIT_S)   # learn each drive's NMT state from its heartbeat
         print(format_status(session.testbed.status()))

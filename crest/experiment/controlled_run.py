@@ -47,6 +47,7 @@ def run_with_controller(session: Session, setpoints: Iterable[SetPoint], control
     if closed_loop:
         testbed.watch_tracker(feed.age_s)
     controller.reset(insertion_mm=testbed.positions().insertion_mm)
+    session.start_fault_clock()
     squared_errors: list[float] = []
     tension_n = None
     cycles = 0

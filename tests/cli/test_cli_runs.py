@@ -47,6 +47,21 @@ def test_a_drive_fault_stops_every_axis_with_its_exit_code_and_keeps_the_log(tmp
     assert axis in sidecar["summary"]["stop_cause"]
 
 
+def test_fault_times_count_from_the_start_of_the_run(tmp_path):
+    """Boot, homing and the move out to the sweep's 80 mm free length take seconds; a fault at
+    @0.5 lands half a second into the logged run, not during homing."""
+    log_path = tmp_path / "run.csv"
+    result = crest("run", "builtin:sweep", "--fast", "--fault", "tendon3:emcy@0.5", "--record", str(log_path))
+    assert result.returncode == ExitCode.EMCY, result.stderr
+    log = read_log(log_path)
+    assert 0.4 <= log.t_s[-1] <= 0.8, log.t_s[-1]
+
+
+def test_status_refuses_a_fault_it_would_never_inject():
+    result = crest("status", "--fault", "tendon1:emcy@1")
+    assert result.returncode == ExitCode.ERROR and "--fault does not apply to status" in result.stderr
+
+
 def test_tracker_loss_in_a_closed_loop_run_stops_safely(tmp_path):
     log_path = tmp_path / "run.csv"
     result = crest("run", "builtin:sweep", "--controller", "dahl+fb", "--insertion-mm", "20", "--fast",
