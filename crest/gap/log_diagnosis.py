@@ -34,7 +34,7 @@ def calibrate_logs(train: Sequence[Path | str], catheter_toml: Path | str | None
     say = progress or (lambda message: None)
     if fit_dynamics is None:
         fit_dynamics = is_fast(recordings)
-        say(f"fit: {100 * fast_travel_share(recordings):.0f}% of the tendon travel at >= "
+        say(f"{100 * fast_travel_share(recordings):.0f}% of the tendon travel at >= "
             f"{FAST_TENDON_SPEED_MM_S:g} mm/s: "
             + ("fast, fitting the damping time and inertia scale too" if fit_dynamics else "quasi-static fit"))
     with ProcessPoolExecutor(settings.workers) if settings.workers > 1 else nullcontext() as pool:
