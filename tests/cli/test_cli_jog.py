@@ -29,11 +29,23 @@ def read_until(fd, needle: bytes, timeout_s: float) -> bytes:
     return out
 
 
-def test_jog_moves_pitch_and_insertion_and_releases_on_quit(tmp_path):
+def start_jog(*args: str) -> tuple[int, subprocess.Popen]:
+    """`crest jog --fast ARGS` on a pseudo-terminal, as an operator runs it: (the terminal's fd, process)."""
     master, slave = pty.openpty()
-    process = subprocess.Popen([*CREST, "jog", "--fast", "--record", str(tmp_path / "jog.csv")], cwd=REPO,
+    process = subprocess.Popen([*CREST, "jog", "--fast", *args], cwd=REPO,
                                stdin=slave, stdout=slave, stderr=slave, close_fds=True)
     os.close(slave)
+    return master, process
+
+
+def end_jog(master: int, process: subprocess.Popen) -> None:
+    os.close(master)
+    if process.poll() is None:
+        process.kill()
+
+
+def test_jog_moves_pitch_and_insertion_and_releases_on_quit(tmp_path):
+    master, process = start_jog("--record", str(tmp_path / "jog.csv"))
     try:
         # homed at 20 mm free length; status line is up. The first run in a fresh environment compiles
         # the model kernel (numba), which on a busy 2-core machine took over 60 s.
@@ -46,9 +58,7 @@ def test_jog_moves_pitch_and_insertion_and_releases_on_quit(tmp_path):
         out += read_until(master, b"released", timeout_s=60)
         assert process.wait(timeout=60) == 0
     finally:
-        os.close(master)
-        if process.poll() is None:
-            process.kill()
+        end_jog(master, process)
     log = read_log(tmp_path / "jog.csv")
     assert log.tendon_cmd_mm[-1, 0] > log.tendon_cmd_mm[-1, 2]     # tendon 1 pulled, tendon 3 paid out
     assert log.insertion_cmd_mm[-1] > log.insertion_cmd_mm[0]
@@ -57,10 +67,7 @@ def test_jog_moves_pitch_and_insertion_and_releases_on_quit(tmp_path):
 
 
 def test_jog_pulling_one_tendon_pays_out_its_partner_and_stops_short_of_the_tension_limit(tmp_path):
-    master, slave = pty.openpty()
-    process = subprocess.Popen([*CREST, "jog", "--fast", "--record", str(tmp_path / "jog.csv")], cwd=REPO,
-                               stdin=slave, stdout=slave, stderr=slave, close_fds=True)
-    os.close(slave)
+    master, process = start_jog("--record", str(tmp_path / "jog.csv"))
     try:
         read_until(master, b"L  20.0 mm", timeout_s=STARTUP_TIMEOUT_S)
         os.write(master, b"1")
@@ -74,9 +81,7 @@ def test_jog_pulling_one_tendon_pays_out_its_partner_and_stops_short_of_the_tens
         out += read_until(master, b"released", timeout_s=60)
         assert process.wait(timeout=60) == 0
     finally:
-        os.close(master)
-        if process.poll() is None:
-            process.kill()
+        end_jog(master, process)
     assert b"tension limit: tendon1" in out
     log = read_log(tmp_path / "jog.csv")
     assert log.tendon_force_n.max() < 40.0                               # never near the safety stop
@@ -86,17 +91,12 @@ def test_jog_pulling_one_tendon_pays_out_its_partner_and_stops_short_of_the_tens
 
 
 def test_a_safety_stop_during_jog_starts_its_message_on_a_new_line():
-    master, slave = pty.openpty()
-    process = subprocess.Popen([*CREST, "jog", "--fast", "--fault", "tendon3:emcy@8.0"], cwd=REPO,
-                               stdin=slave, stdout=slave, stderr=slave, close_fds=True)
-    os.close(slave)
+    master, process = start_jog("--fault", "tendon3:emcy@8.0")
     try:
         out = read_until(master, b"L  20.0 mm", timeout_s=STARTUP_TIMEOUT_S)      # the status line is up
         out += read_until(master, b"all axes were quick-stopped", timeout_s=120)
         assert process.wait(timeout=60) == ExitCode.EMCY
     finally:
-        os.close(master)
-        if process.poll() is None:
-            process.kill()
+        end_jog(master, process)
     before_stop = out[:out.index(b"crest: safety stop")]
     assert before_stop.endswith(b"\n"), before_stop[-200:]       # not appended to the status line
