@@ -159,4 +159,4 @@ def test_fault_and_effect_help_list_every_kind_axis_and_effect_id():
         assert axis in text
     for effect_id, effect in EFFECTS.items():
         assert f"{effect_id} ({', '.join(effect.param_names)})" in text
-    assert "SECONDS counts from the moment the virtual testbed powers up, before boot and homing" in text
+    assert "SECONDS counts from the start of the command's motion" in text
