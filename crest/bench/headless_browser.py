@@ -35,7 +35,7 @@ def browser_missing() -> str | None:
     try:
         import selenium  # noqa: F401  (only asks whether it is installed)
     except ImportError:
-        return "selenium is not installed (pip install -e '.[test]')"
+        return "selenium is not installed (pip install '.[test]')"
     return None
 
 

@@ -64,9 +64,11 @@ def run(args: argparse.Namespace) -> int:
                                        overwrite=args.overwrite) if path else None)
         on_cycle = view.follow(f"move to pitch {args.pitch:g} deg, yaw {args.yaw:g} deg, controller "
                                f"{args.controller}", trajectory.tip_mm, len(trajectory))
-        run_with_controller(session, trajectory, controller, recorder=recorder,
-                            closed_loop=args.controller == "dahl+fb", on_cycle=on_cycle)
-        tip = session.tracker.latest() if session.tracker else None
+        result = run_with_controller(session, trajectory, controller, recorder=recorder,
+                                     closed_loop=args.controller == "dahl+fb", on_cycle=on_cycle)
+        lost = result.tip_coverage.loss_sentence()
+        # the tracker's last frame is a measurement of the end pose only while the tracker is still there
+        tip = session.tracker.latest() if session.tracker and lost is None else None
         if recorder:
             recorder.close()
     goal = trajectory.tip_mm[-1]
@@ -74,6 +76,8 @@ def run(args: argparse.Namespace) -> int:
     if tip is not None and tip.tip_mm is not None:
         print(f"tracked tip {np.array2string(np.asarray(tip.tip_mm), precision=2)} mm, "
               f"{np.linalg.norm(tip.tip_mm - goal):.2f} mm from the target")
+    if lost:
+        print(f"no tracked tip at the end: {lost}")
     if recorder:
         print(f"log: {recorder.path}")
     return 0

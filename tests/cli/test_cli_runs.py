@@ -142,3 +142,11 @@ def test_killed_process_leaves_a_readable_log(tmp_path):
         warnings.simplefilter("ignore", TruncatedLogWarning)   # a partly written last line is allowed
         log = read_log(log_path)
     assert len(log) >= 150
+
+
+def test_move_that_loses_the_tracker_reports_no_tip_instead_of_the_last_one_seen():
+    result = crest("move", "--pitch", "60", "--yaw", "0", "--insertion", "80", "--fast",
+                   "--fault", "tracker:disconnect@0.3")
+    assert result.returncode == 0, result.stderr
+    assert not any(line.startswith("tracked tip") for line in result.stdout.splitlines())  # a frame from before the loss
+    assert "no tracked tip at the end: tracker lost at" in result.stdout
