@@ -66,13 +66,12 @@ def reproduce(out_dir: str | Path, settings: PaperSettings, progress: TextIO | N
     figures = {}
     for index, study in enumerate(STUDIES, start=1):
         started = time.perf_counter()
-        if progress is not None:
-            print(f"crest paper [{index}/{len(STUDIES)}] {study.TITLE} ...", end="", file=progress, flush=True)
         name = Path(study.FIGURE).stem
         figures[name] = study.run(settings, out)
         require_finite(figures[name], name)
-        if progress is not None:
-            print(f" {study.FIGURE} in {time.perf_counter() - started:.1f} s", file=progress, flush=True)
+        if progress is not None:     # one whole line per study, so a compile notice never splits it
+            print(f"crest paper [{index}/{len(STUDIES)}] {study.TITLE}: {study.FIGURE} in "
+                  f"{time.perf_counter() - started:.1f} s", file=progress, flush=True)
     summary = {
         "paper": PAPER,
         "settings": {"n_elements": settings.n_elements, "mu_sweep": settings.mu_sweep,

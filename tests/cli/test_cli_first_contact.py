@@ -28,11 +28,14 @@ def test_a_non_editable_install_finds_its_configs_and_eds(tmp_path):
     python = venv / "bin" / "python"
     site_packages = Path(subprocess.run([str(python), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
                                         check=True, capture_output=True, text=True).stdout.strip())
-    # the dependencies (numpy, numba, canopen, ...) from this interpreter's site-packages, never the repo
-    (site_packages / "test_dependencies.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
     wheel, = (tmp_path / "dist").glob("crest_hil-*.whl")
     subprocess.run([*pip, "--python", str(python), "install", "--no-deps", "-q", str(wheel)], check=True,
                    capture_output=True, timeout=600)
+    # then the dependencies (numpy, numba, canopen, ...) from this interpreter's site-packages, never the repo.
+    # After the install: were they visible before it, pip would find an installed crest-hil there (as in CI,
+    # which installs the repo) and install nothing.
+    dependencies = [path for path in sys.path if path.endswith("site-packages")]
+    (site_packages / "test_dependencies.pth").write_text("\n".join(dependencies) + "\n")
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
     env = {key: value for key, value in os.environ.items() if key != "PYTHONPATH"}
