@@ -41,7 +41,7 @@ def model_step(params: CatheterParams) -> dict:
 
 
 def dynamic_model_step(params: CatheterParams, damping_time_s: float = 0.02, inertia_scale: float = 1.0) -> dict:
-    """model_step in the dynamic mode (backward Euler, steps of at most 5 ms: two per 10 ms sample).
+    """model_step in the dynamic mode (backward Euler, steps of at most 10 ms: one per 10 ms sample).
 
     Unless the parameters already set them, a 20 ms damping time and the catheter's own mass.
     """
