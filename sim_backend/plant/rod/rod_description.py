@@ -23,7 +23,7 @@ class RodDescriptionError(ValueError):
 _LAYOUT = {
     "shaft": {"youngs_modulus_mpa": "youngs_modulus_mpa", "outer_diameter_mm": "outer_diameter_mm",
               "inner_diameter_mm": "inner_diameter_mm", "axial_stiffness_n": "axial_stiffness_n",
-              "grid_nodes": "grid_nodes"},
+              "grid_nodes": "grid_nodes", "damping_time_s": "damping_time_s"},
     "tendons": {"offset_mm": "tendon_offset_mm", "axial_stiffness_n": "tendon_axial_stiffness_n",
                 "drive_compliance_mm_per_n": "drive_compliance_mm_per_n",
                 "zero_offsets_mm": "tendon_zero_offsets_mm"},
@@ -44,6 +44,7 @@ class RodDescription:
     inner_diameter_mm: float = 3.0
     axial_stiffness_n: float = 1.0e5           # EA of the shaft
     grid_nodes: int = 200                       # nodes over the free length
+    damping_time_s: float = 0.0                 # Kelvin-Voigt retardation time eta/E of the shaft (0: quasi-static)
     tendon_offset_mm: float = 2.3               # radius of the tendon lumens from the neutral axis
     tendon_axial_stiffness_n: float = 4.0e4     # EA_t of a tendon
     drive_compliance_mm_per_n: float = 0.01     # drive line outside the catheter, mm of stretch per N
@@ -84,7 +85,7 @@ class RodDescription:
         positive = ("youngs_modulus_mpa", "outer_diameter_mm", "axial_stiffness_n", "tendon_offset_mm",
                     "tendon_axial_stiffness_n")
         non_negative = ("inner_diameter_mm", "drive_compliance_mm_per_n", "mu", "friction_n_per_mm",
-                        "tracker_noise_mm")
+                        "tracker_noise_mm", "damping_time_s")
         for name in positive + non_negative:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):

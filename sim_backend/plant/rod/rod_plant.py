@@ -14,6 +14,12 @@ Each step (quasi-static, step_solver.py does the rod and tendons):
    +-F_grip / k_shaft of the axis.
 3. Solve for the drive tensions (Newton) with the friction return mapping from the last profile;
    a step that does not converge is retried in 4, 16, 64 increments of the pull.
+   With a damping time tau > 0 (Kelvin-Voigt shaft material, [shaft] damping_time_s) the
+   bending moment is EI (kappa - kappa_rest) + tau EI dkappa/dt. Backward Euler over an increment
+   of dt [s] from the curvature kappa_n it started at turns this into the static rod with
+       EI_dt = EI (1 + tau/dt),   kappa_rest_dt = (kappa_rest + (tau/dt) kappa_n) / (1 + tau/dt),
+   so each increment is the same quasi-static solve (implicit, unconditionally stable; the
+   shaft's mass is neglected: the curvature relaxes to the static shape with time constant tau).
 4. Creep (sheath_creep): the rest curvature relaxes toward f (kappa - kappa_set),
    kappa_c += (f (kappa - kappa_set) - kappa_c) (1 - exp(-dt / tau)).
 5. The tip: the last node, plus the sensor's mount offset turned by the tip frame (tracker_offset).
@@ -95,9 +101,12 @@ class RodPlant:
         mu = self.description.mu * (1.0 + self._mu_rate * speed_mm_s)
         kappa_rest = nodes["kappa_set"] + self.creep_per_mm
         start_mm = self.pull_mm
+        remaining_s = dt_s
         for substeps in SUBSTEPS:
-            if self._follow(self.pull_mm, pull, substeps, nodes, mu, kappa_rest):
+            fraction = self._follow(self.pull_mm, pull, substeps, nodes, mu, kappa_rest, remaining_s)
+            if fraction == 1.0:
                 break
+            remaining_s *= 1.0 - fraction
         else:
             raise RodSolverError(f"rod plant: no tendon-tension solution within {MAX_ITERATIONS} Newton iterations "
                                  f"from pull {np.round(start_mm, 4)} to {np.round(pull, 4)} mm even in "
@@ -109,26 +118,34 @@ class RodPlant:
         tip = self.position_mm[-1] + self.rotation[-1] @ self._sensor_mm
         return tip, self.drive_tension_n.copy()
 
-    def _follow(self, start_mm, pull_mm, substeps: int, nodes: dict, mu, kappa_rest) -> bool:
-        """Move the pull from start_mm to pull_mm in `substeps` equal quasi-static increments,
-        each from the friction state the last one left; False (state at the last increment that
-        converged) if one does not converge."""
+    def _follow(self, start_mm, pull_mm, substeps: int, nodes: dict, mu, kappa_rest, dt_s: float) -> float:
+        """Move the pull from start_mm to pull_mm in `substeps` equal increments of dt_s/substeps
+        each, each from the friction state (and, with damping, the curvature) the last one left.
+        Returns the fraction of the increments done: 1.0, or less if one did not converge (the
+        state is then the last converged increment's)."""
+        ei, rest = nodes["ei"], kappa_rest
+        tau_over_dt = self.description.damping_time_s * substeps / dt_s if dt_s > 0.0 else 0.0
         for j in range(1, substeps + 1):
             target = start_mm + (pull_mm - start_mm) * (j / substeps)
             tension = np.empty_like(self.tension_n)
             drive = self.drive_tension_n.copy()
-            iterations = solve_step(nodes["h_mm"], nodes["ei"], nodes["r"], nodes["cos_phi"], nodes["sin_phi"],
-                                    nodes["ea_axial"], kappa_rest, nodes["kappa_set"], nodes["weight"],
+            kappa = self.kappa_per_mm.copy()
+            if tau_over_dt > 0.0:     # Kelvin-Voigt by backward Euler (module doc, step 3)
+                ei = nodes["ei"] * (1.0 + tau_over_dt)
+                rest = (kappa_rest + tau_over_dt * self.kappa_per_mm) / (1.0 + tau_over_dt)
+            iterations = solve_step(nodes["h_mm"], ei, nodes["r"], nodes["cos_phi"], nodes["sin_phi"],
+                                    nodes["ea_axial"], rest, nodes["kappa_set"], nodes["weight"],
                                     self._drive_compliance, self.description.tendon_axial_stiffness_n, mu,
                                     self.description.friction_n_per_mm, target, self.tension_n, drive, tension,
-                                    self.kappa_per_mm, self.rotation, self.position_mm, TOLERANCE_MM, MAX_ITERATIONS)
+                                    kappa, self.rotation, self.position_mm, TOLERANCE_MM, MAX_ITERATIONS)
             if iterations < 0:
-                return False
+                return (j - 1) / substeps
             self.iterations = iterations
             self.tension_n = tension
             self.drive_tension_n = drive
+            self.kappa_per_mm = kappa
             self.pull_mm = target
-        return True
+        return 1.0
 
     # -- free length and the grid ---------------------------------------------------------------
     def _move_free_length(self, insertion_mm: float) -> None:
