@@ -47,6 +47,8 @@ CONDITIONING_PERIOD_S = 3.0      # ... of this period
 MOVE_VELOCITY_RAD_S = 1.2        # articulation moves between primitives
 MOVE_ACCELERATION_RAD_S2 = 2.0
 INSERTION_ACCELERATION_MM_S2 = 20.0
+STEP_SHARE = 0.9                 # steps of the fast-input excitation: this share of the tendon axes' limits
+MULTISINE_RAMP_S = 1.5           # raised-cosine fade in and out of each multisine
 
 
 def _direction(plane_deg: float) -> np.ndarray:
@@ -109,6 +111,31 @@ class _Excitation:
         self.path.samples(math.radians(bend_deg) * np.column_stack([np.cos(phi), np.sin(phi)]),
                           np.full(len(phi), self.path.insertion_mm),
                           f"circle at {bend_deg:g} deg, {'ccw' if turns > 0 else 'cw'}")
+
+    def step(self, bend_deg: float, plane_deg: float, hold_s: float) -> None:
+        """A step: the fastest move the tendon axes allow (STEP_SHARE of their speed and acceleration
+        limits, as bend rates: |b'| <= v_max / r), then a hold that shows the transient settle."""
+        r = self.workspace.tendon_offset_mm
+        limits = self.path.limits
+        self.path.line(math.radians(bend_deg) * _direction(plane_deg), self.path.insertion_mm,
+                       f"step to {bend_deg:g} deg in plane {plane_deg:g} deg",
+                       bend_velocity_rad_s=STEP_SHARE * limits.tendon_velocity_mm_s / r,
+                       bend_acceleration_rad_s2=STEP_SHARE * limits.tendon_acceleration_mm_s2 / r)
+        self.hold(hold_s)
+
+    def multisine(self, plane_deg: float, centre_deg: float, tones: tuple[tuple[float, float, float], ...],
+                  duration_s: float) -> None:
+        """theta = c + w(t) sum_i a_i sin(2 pi f_i t + phi_i) in one plane, tones = ((a_i [deg], f_i [Hz],
+        phi_i [rad]), ...), after a move to c. The window w rises and falls as a raised cosine over
+        MULTISINE_RAMP_S at each end, so the multisine starts and ends at rest at c."""
+        self.move(centre_deg, plane_deg)
+        t = self._times(duration_s)
+        ramp = np.clip(np.minimum(t, duration_s - t) / MULTISINE_RAMP_S, 0.0, 1.0)
+        window = 0.5 * (1.0 - np.cos(np.pi * ramp))
+        theta_deg = centre_deg + window * sum(a * np.sin(2 * np.pi * f * t + phase) for a, f, phase in tones)
+        self.path.samples(np.radians(theta_deg)[:, None] * _direction(plane_deg),
+                          np.full(len(t), self.path.insertion_mm),
+                          f"multisine plane {plane_deg:g} deg about {centre_deg:g} deg")
 
     def insertion_cycle(self, bend_deg: float, plane_deg: float, speed_mm_s: float, hold_s: float = 1.5) -> None:
         """At constant articulation: free length nominal -> longest -> shortest -> nominal, with holds.
@@ -215,3 +242,28 @@ def holdout_trajectory(workspace: Workspace, limits: MotionLimits = MotionLimits
         b.circle(85.0, 45.0, -1.0, 9.0)
         b.circle(85.0, 45.0, 1.0, 9.0)
     return b.trajectory()
+
+
+def fast_input_trajectories(workspace: Workspace, limits: MotionLimits = MotionLimits(),
+                            period_s: float = 0.01) -> dict[str, Trajectory]:
+    """The fast-input excitation for the dynamic mode (`crest excite --fast-inputs`): "train" and
+    "holdout" (about 53 s and 33 s), each steps at the tendon axes' limits with holds, and
+    multisines of three tones pulling the tendons at up to about 16 mm/s (the peak rate of
+    r*theta, r*sum a_i 2 pi f_i) in other planes, amplitudes, frequencies and phases for each.
+    At these speeds the catheter's damping and mass show (model.gap.calibration.is_fast)."""
+    logs = {}
+    for name, (step_planes, steps_deg, sine_planes, centre_deg, tones) in {
+        "train": ((0.0, 90.0), (60.0, 120.0, 30.0, 0.0), (0.0, 90.0), 50.0,
+                  ((35.0, 0.4, 0.0), (18.0, 1.1, 1.3), (9.0, 2.7, 2.9))),
+        "holdout": ((180.0, 270.0), (90.0, 40.0, 0.0), (270.0,), 45.0,
+                    ((30.0, 0.5, 0.7), (16.0, 1.4, 2.1), (8.0, 2.3, 0.4))),
+    }.items():
+        b = _Excitation(workspace, limits, period_s)
+        b.hold(2.0)
+        for plane_deg in step_planes:
+            for bend_deg in steps_deg:
+                b.step(bend_deg, plane_deg, hold_s=1.5)
+        for plane_deg in sine_planes:
+            b.multisine(plane_deg, centre_deg, tones, duration_s=15.0)
+        logs[name] = b.trajectory()
+    return logs

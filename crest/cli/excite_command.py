@@ -1,4 +1,5 @@
-"""`crest excite --record DIR`: the standard calibration and diagnosis experiment.
+"""`crest excite --record DIR`: the standard calibration and diagnosis experiment (or, with
+--fast-inputs, steps and multisines for the dynamic mode).
 
 Runs the training and the held-out excitation (control/excitation.py: sweeps in several planes,
 amplitudes and speeds, reversals and minor loops, insertion changes at constant articulation,
@@ -22,7 +23,11 @@ def add_parser(sub) -> None:
     parser = sub.add_parser("excite", help="record the training and held-out excitation logs for fit and gap")
     parser.add_argument("--record", type=Path, required=True, metavar="DIR", help="directory for the two logs")
     add_overwrite_option(parser)
-    parser.add_argument("--short", action="store_true", help="the short excitation (about 95 s + 65 s)")
+    kind = parser.add_mutually_exclusive_group()
+    kind.add_argument("--short", action="store_true", help="the short excitation (about 95 s + 65 s)")
+    kind.add_argument("--fast-inputs", action="store_true",
+                      help="steps at the tendon axes' limits and multisines at up to about 16 mm/s of pull "
+                           "(about 53 s + 33 s), for fitting the dynamic mode (crest fit --dynamics)")
     parser.add_argument("--catheter", type=Path, default=None, help="catheter parameters TOML (geometry)")
     add_testbed_options(parser)
     parser.set_defaults(handler=run)
@@ -31,7 +36,7 @@ def add_parser(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     config = load_testbed_config(args.config)
     params = catheter_params(args)
-    plan = plan_excitation(config, params, short=args.short)      # refused before anything moves
+    plan = plan_excitation(config, params, short=args.short, fast_inputs=args.fast_inputs)   # refused before motion
     check_output(args.record, directory=True)
     for name in plan.logs:
         check_log_outputs(args.record / f"{name}.csv", args.overwrite)

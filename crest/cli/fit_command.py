@@ -1,13 +1,17 @@
-"""`crest fit TRAIN.csv [...] --out catheter.toml`: calibrate the base Dahl model on training logs."""
+"""`crest fit TRAIN.csv [...] --out catheter.toml [--holdout LOG ...]`: calibrate the base Dahl model on
+training logs, and report its tip RMSE on held-out logs it was not fitted to."""
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
 from crest.cli.common_options import check_output
 from crest.gap.log_diagnosis import calibrate_logs, prior_catheter
+from crest.gap.log_recordings import load_recordings
+from model.gap.calibration import rmse_mm, tip_errors
 from model.gap.diagnosis import DiagnosisSettings
 
 FITTED = ("bending_stiffness_nmm2", "axial_stiffness_n", "mu", "sigma_n_per_mm2", "fsc_n_per_mm",
@@ -23,6 +27,8 @@ def add_parser(sub) -> None:
     parser.add_argument("--dynamics", choices=list(DYNAMICS_CHOICES), default="auto",
                         help="also fit the damping time and inertia scale: auto (when 30 %% of the logs' "
                              "tendon travel is at >= 8 mm/s: steps, fast multisines), on or off")
+    parser.add_argument("--holdout", nargs="+", type=Path, default=[], metavar="LOG",
+                        help="held-out logs: also report the fitted model's tip RMSE on them (never fitted to)")
     parser.add_argument("--json", dest="json_path", type=Path, default=None,
                         help="also write the fit (values, std, correlations, flags) as JSON")
     parser.set_defaults(handler=run)
@@ -31,9 +37,14 @@ def add_parser(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     check_output(args.out)                                         # refused now, not after the fit
     check_output(args.json_path)
-    fit = calibrate_logs(args.train, args.catheter, DiagnosisSettings(),
+    held = load_recordings(args.holdout)                           # a bad file is refused before the fit
+    settings = DiagnosisSettings()
+    fit = calibrate_logs(args.train, args.catheter, settings,
                          progress=lambda message: print(f"crest fit: {message}", file=sys.stderr, flush=True),
                          fit_dynamics=DYNAMICS_CHOICES[args.dynamics])
+    holdout_rmse_mm = rmse_mm(tip_errors(fit, settings.resolution.prepare(held), settings.resolution)) if held else None
+    if holdout_rmse_mm is not None and not math.isfinite(holdout_rmse_mm):
+        raise SystemExit("crest fit: the fitted model diverges on the held-out logs; are they of the same catheter?")
     prior = prior_catheter(args.catheter)
     fitted = prior.replace(tendon_offset_mm=fit.params.tendon_offset_mm,
                            outer_diameter_mm=fit.params.outer_diameter_mm,
@@ -42,16 +53,21 @@ def run(args: argparse.Namespace) -> int:
               f"# training tip RMSE {fit.train_rmse_mm:.3f} mm",
               "# tendon zero offsets (mm, subtract from the drive position): "
               + ", ".join(f"{z:+.5f}" for z in fit.zero_offsets_mm)]
+    if held:
+        header.append(f"# held-out tip RMSE {holdout_rmse_mm:.3f} mm on {', '.join(str(p) for p in args.holdout)}")
     header += [f"# FLAG: {flag}" for flag in fit.flags]
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text("\n".join(header) + "\n" + fitted.to_toml())
     if args.json_path:
         args.json_path.parent.mkdir(parents=True, exist_ok=True)
-        args.json_path.write_text(json.dumps(fit.as_dict(), indent=2))
+        args.json_path.write_text(json.dumps({**fit.as_dict(), "holdout_rmse_mm": holdout_rmse_mm,
+                                              "holdout": [str(p) for p in args.holdout]}, indent=2))
     print(f"{'parameter':<24} {'value':>12} {'std':>10}")
     for name, value, std in zip(fit.names, fit.values, fit.std):
         print(f"{name:<24} {value:>12.5g} {std:>10.2g}")
     print(f"training tip RMSE {fit.train_rmse_mm:.3f} mm")
+    if held:
+        print(f"held-out tip RMSE {holdout_rmse_mm:.3f} mm ({', '.join(r.name for r in held)})")
     for a, b, c in fit.strongest_correlations():
         print(f"correlated: {a} / {b} ({c:+.2f})")
     for flag in fit.flags:

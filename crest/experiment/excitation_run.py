@@ -15,7 +15,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from control.controllers.constant_curvature import ConstantCurvatureController
-from control.excitation import conditioning_trajectory, holdout_trajectory, training_trajectory
+from control.excitation import (conditioning_trajectory, fast_input_trajectories, holdout_trajectory,
+                                training_trajectory)
 from control.trajectories import Trajectory
 from crest.config import TestbedConfig
 from crest.experiment.controlled_run import RunResult, run_with_controller
@@ -35,15 +36,18 @@ class ExcitationPlan:
     logs: dict[str, Trajectory]
 
 
-def plan_excitation(config: TestbedConfig, params: CatheterParams, short: bool = False) -> ExcitationPlan:
+def plan_excitation(config: TestbedConfig, params: CatheterParams, short: bool = False,
+                    fast_inputs: bool = False) -> ExcitationPlan:
     """Conditioning, "train" and "holdout" at the SYNC period, inside the workspace and the axes' limits
-    (a trajectory that is not raises TrajectoryError here, before anything moves)."""
+    (a trajectory that is not raises TrajectoryError here, before anything moves). fast_inputs: the
+    steps and multisines of `fast_input_trajectories` instead of the standard excitation."""
     workspace = workspace_for(config, params)
     limits = limits_for(config)
     period_s = config.sync.period_s
-    return ExcitationPlan(conditioning_trajectory(workspace, limits, period_s),
-                          {"train": training_trajectory(workspace, limits, period_s, short=short),
-                           "holdout": holdout_trajectory(workspace, limits, period_s, short=short)})
+    logs = (fast_input_trajectories(workspace, limits, period_s) if fast_inputs else
+            {"train": training_trajectory(workspace, limits, period_s, short=short),
+             "holdout": holdout_trajectory(workspace, limits, period_s, short=short)})
+    return ExcitationPlan(conditioning_trajectory(workspace, limits, period_s), logs)
 
 
 def record_excitation(session: Session, plan: ExcitationPlan, folder: Path, params: CatheterParams,

@@ -120,6 +120,15 @@ def test_fit_on_a_missing_log_says_the_log_is_missing(tmp_path):
     assert f"{missing}: no such file" in result.stderr and "sidecar" not in result.stderr
 
 
+def test_fit_reads_its_held_out_logs_before_the_fit(tmp_path):
+    """A missing --holdout log is named at once, not after minutes of fitting the training logs."""
+    missing = tmp_path / "held.csv"
+    result = crest("fit", str(tmp_path / "train.csv"), "--holdout", str(missing), "--out", str(tmp_path / "fitted.toml"))
+    assert result.returncode == ExitCode.ERROR
+    assert f"{missing}: no such file" in result.stderr and "starts fitted" not in result.stderr
+    assert not (tmp_path / "fitted.toml").exists()
+
+
 def test_fit_progress_has_one_prefix(monkeypatch):
     from crest.gap import log_diagnosis
 

@@ -8,6 +8,7 @@ from crest.config import load_testbed_config
 from crest.experiment.excitation_run import plan_excitation
 from crest.experiment.workspace_from_config import limits_for, workspace_for
 from model import CatheterParams, DahlCatheter
+from model.gap.calibration import FAST_TENDON_SPEED_MM_S, FAST_TRAVEL_SHARE
 
 CONFIG = load_testbed_config()
 
@@ -90,3 +91,18 @@ def test_other_sample_rates_keep_the_shape():
     coarse = training_trajectory(workspace, limits, 0.05, short=True)
     assert coarse.duration_s == pytest.approx(fine.duration_s, rel=0.02)
     assert holdout_trajectory(workspace, limits, 0.05, short=True).duration_s < coarse.duration_s
+
+
+@pytest.mark.parametrize("name", ["train", "holdout"])
+def test_fast_input_excitation_steps_at_the_axis_limits_and_is_fast(name):
+    """`crest excite --fast-inputs`: steps and multisines inside the axes' limits, fast enough that
+    `crest fit --dynamics auto` fits the dynamic mode (30 % of the tendon travel at >= 8 mm/s)."""
+    trajectory = plan_excitation(CONFIG, CatheterParams.from_toml(), fast_inputs=True).logs[name]
+    labels = " | ".join(sorted(set(trajectory.labels)))
+    assert "step to" in labels and "multisine" in labels
+    assert_within_axis_limits(trajectory)
+    travel_mm = np.abs(np.diff(trajectory.tendon_mm, axis=0)).max(axis=1)
+    speed_mm_s = travel_mm / trajectory.period_s
+    assert speed_mm_s.max() > 0.85 * trajectory.limits.tendon_velocity_mm_s      # the steps
+    assert travel_mm[speed_mm_s >= FAST_TENDON_SPEED_MM_S].sum() >= FAST_TRAVEL_SHARE * travel_mm.sum()
+    assert np.allclose(trajectory.bend_rad[-1], 0.0)
