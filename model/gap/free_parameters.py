@@ -64,8 +64,25 @@ class FreeParameter:
         return None
 
 
+TENDON_OFFSET_FIT_SPAN = 0.4       # the tendon offset is fitted within +-40 % of its nominal value
+TENDON_OFFSET_PHYSICAL_SPAN = 0.2  # and is plausible within +-20 %
+
+
+def tendon_offset_bounds_mm(nominal_mm: float, outer_diameter_mm: float, span: float) -> tuple[float, float]:
+    """nominal * (1 -+ span), below 95 % of the outer radius (the lumens lie inside the shaft)."""
+    return nominal_mm * (1.0 - span), min(nominal_mm * (1.0 + span), 0.95 * outer_diameter_mm / 2.0)
+
+
 def base_parameters(prior: CatheterParams) -> tuple[FreeParameter, ...]:
-    """Bending and axial stiffness, mu, sigma, Fsc and the four tendon zero offsets.
+    """Bending and axial stiffness, mu, sigma, Fsc, the tendon offset and the four tendon zero offsets.
+
+    The tendon offset (the tendons' moment arm r) is fitted because no catheter's is known well:
+    lumens sit off their drawn radius, tendons lie against one side of their lumen, and the
+    real robot of ../shared/data bends as if its arm were 7-7.6 mm where its code says 8 or 4.
+    The bend per mm of pull is about 1/r, so an arm 8 % off leaves a tip error that grows with
+    articulation, and the other parameters leave their physical ranges trying to absorb it (the
+    rod plant, r = 2.3 mm against a nominal 2.5: held-out 2.5 mm with mu at 0.68, 0.87 mm with
+    the arm right).
 
     Tendon zeros are scaled by the tendon's own compliance L/EA_t (mm per N): with stiff
     tendons a zero error of a few micrometres changes the pretension by a newton and moves the
@@ -80,25 +97,28 @@ def base_parameters(prior: CatheterParams) -> tuple[FreeParameter, ...]:
     ei, ea, sigma = prior.bending_stiffness_nmm2, prior.axial_stiffness_n, prior.sigma_n_per_mm2
     fsc_scale = max(prior.fsc_n_per_mm, 0.005)
     zero_scale = prior.max_free_length_mm / prior.tendon_stiffness_n
+    r, diameter = prior.tendon_offset_mm, prior.outer_diameter_mm
     return (
         FreeParameter("bending_stiffness_nmm2", ei / 1000, ei * 1000, (ei / 10, ei * 10), log_reference=ei),
         FreeParameter("axial_stiffness_n", ea / 1e4, ea * 1e3, (ea / 100, ea * 100), log_reference=ea),
         FreeParameter("mu", 0.0, 1.0, (0.02, 0.6), scale=0.1),
         FreeParameter("sigma_n_per_mm2", sigma / 1000, sigma * 12, (sigma / 10, sigma * 10), log_reference=sigma),
         FreeParameter("fsc_n_per_mm", 0.0, 0.06, (0.0, 0.05), scale=fsc_scale),
+        FreeParameter("tendon_offset_mm", *tendon_offset_bounds_mm(r, diameter, TENDON_OFFSET_FIT_SPAN),
+                      tendon_offset_bounds_mm(r, diameter, TENDON_OFFSET_PHYSICAL_SPAN), scale=0.05 * r),
     ) + tuple(FreeParameter(f"tendon_zero_{k + 1}_mm", -3.0, 3.0, (-1.0, 1.0), scale=zero_scale)
               for k in range(N_TENDONS))
 
 
-N_BASE = 9
-BASE_NAMES = ("bending_stiffness_nmm2", "axial_stiffness_n", "mu", "sigma_n_per_mm2", "fsc_n_per_mm") + tuple(
-    f"tendon_zero_{k + 1}_mm" for k in range(N_TENDONS))
+N_BASE = 10
+BASE_NAMES = ("bending_stiffness_nmm2", "axial_stiffness_n", "mu", "sigma_n_per_mm2", "fsc_n_per_mm",
+              "tendon_offset_mm") + tuple(f"tendon_zero_{k + 1}_mm" for k in range(N_TENDONS))
 
 
 def base_values(params: CatheterParams, zero_offsets_mm: Sequence[float]) -> dict[str, float]:
     """The base parameters by name (BASE_NAMES order)."""
     values = [params.bending_stiffness_nmm2, params.axial_stiffness_n, params.mu, params.sigma_n_per_mm2,
-              params.fsc_n_per_mm, *zero_offsets_mm]
+              params.fsc_n_per_mm, params.tendon_offset_mm, *zero_offsets_mm]
     return dict(zip(BASE_NAMES, (float(v) for v in values)))
 
 
@@ -167,10 +187,10 @@ class ParameterLayout:
         """(catheter params, zero offsets [4] mm, {effect id: values}) from z; fixed parts from the arguments."""
         values = [p.from_z(float(v)) for p, v in zip(self.parameters, z)]
         if self.fit_base:
-            ei, ea, mu, sigma, fsc = values[:5]
+            ei, ea, mu, sigma, fsc, offset = values[:6]
             params = params.replace(bending_stiffness_nmm2=ei, axial_stiffness_n=ea, mu=max(mu, 0.0),
-                                    sigma_n_per_mm2=sigma, fsc_n_per_mm=max(fsc, 0.0))
-            zero_offsets_mm = values[5:N_BASE]
+                                    sigma_n_per_mm2=sigma, fsc_n_per_mm=max(fsc, 0.0), tendon_offset_mm=offset)
+            zero_offsets_mm = values[6:N_BASE]
             values = values[N_BASE:]
         if self.fit_dynamics:
             params = params.replace(**{name: max(v, 0.0) for name, v in zip(DYNAMIC_NAMES, values)})

@@ -14,6 +14,7 @@ import numpy as np
 
 from model.dahl_catheter import DahlCatheter
 from model.effect_terms import EffectTerms
+from model.gap.free_parameters import TENDON_OFFSET_FIT_SPAN
 from model.gap.recording import Recording, RecordingError
 from model.params import CatheterParams
 
@@ -72,8 +73,9 @@ class Resolution:
 def catheter_for(base: CatheterParams, recordings: Sequence[Recording]) -> CatheterParams:
     """`base` with the geometry of the recordings (which must agree) and ranges that admit their inputs.
 
-    Tendon offset, outer diameter and maximum free length come from the recordings; the free
-    length at reset is set per recording by `predict_tips`.
+    Outer diameter and maximum free length come from the recordings; the free length at reset is
+    set per recording by `predict_tips`. The tendon offset is the recordings' nominal one, unless
+    `base` has one within the fit's span of it (TENDON_OFFSET_FIT_SPAN): a fitted offset, kept.
     """
     first = recordings[0]
     for r in recordings[1:]:
@@ -84,6 +86,8 @@ def catheter_for(base: CatheterParams, recordings: Sequence[Recording]) -> Cathe
                                  f"({first.tendon_offset_mm} mm, {first.flexible_length_mm} mm); "
                                  "analyse logs of one catheter together")
     offset = first.tendon_offset_mm
+    if abs(base.tendon_offset_mm / offset - 1.0) <= TENDON_OFFSET_FIT_SPAN:
+        offset = base.tendon_offset_mm
     diameter = first.outer_diameter_mm
     if diameter is None:
         diameter = max(base.outer_diameter_mm, 2.2 * offset)
