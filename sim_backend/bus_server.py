@@ -18,13 +18,53 @@ from __future__ import annotations
 import sys
 import threading
 
-from can_remote.server import RemoteServer
+from can_remote.server import ClientRequestHandler, RemoteServer, RemoteServerProtocol
+from can_remote.websocket import WebSocket, get_accept_key
 
 LOCALHOST = "127.0.0.1"
 SHUTDOWN_POLL_S = 0.1   # how often serve_forever looks for a shutdown request
 
 
+class _ClientConnection(RemoteServerProtocol):
+    """python-can-remote's connection to one client, which also lets go of a vanished client.
+
+    The library's sending thread dies with a traceback when the client's socket is gone (killed
+    client) and leaves the client's handle on the virtual bus open, where it would queue every
+    frame of the bus for nobody, without end. Here the thread ends quietly and closes the handle.
+    """
+
+    def _send_to_client(self) -> None:
+        try:
+            super()._send_to_client()
+        except OSError:         # the client's socket is gone; its receive side reports it
+            self.running = False
+            self.bus.shutdown()
+
+
+class _ClientHandler(ClientRequestHandler):
+    def start_websocket(self) -> None:
+        """The library's WebSocket upgrade (can_remote.server), with `_ClientConnection`."""
+        self.send_response(101)
+        self.send_header("Upgrade", "WebSocket")
+        self.send_header("Connection", "Upgrade")
+        self.send_header("Sec-WebSocket-Accept", get_accept_key(self.headers["Sec-WebSocket-Key"]))
+        offered = [name.strip() for name in self.headers.get("Sec-WebSocket-Protocol", "can.json.v1").split(",")]
+        protocol = "can.binary+json.v1" if "can.binary+json.v1" in offered else "can.json.v1"
+        self.send_header("Sec-WebSocket-Protocol", protocol)
+        self.end_headers()
+        connection = _ClientConnection(self.server.config, WebSocket(None, protocol, sock=self.request))
+        self.server.clients.append(connection)
+        try:
+            connection.run()
+        finally:
+            self.server.clients.remove(connection)
+
+
 class _LocalRemoteServer(RemoteServer):
+    def __init__(self, host: str, port: int, **config) -> None:
+        super().__init__(host, port, **config)
+        self.RequestHandlerClass = _ClientHandler
+
     def handle_error(self, request, client_address) -> None:
         """A client's connection broke off (socketserver's default prints a traceback)."""
         error = sys.exc_info()[1]
