@@ -20,7 +20,7 @@ import can
 
 from crest.config import TestbedConfig
 from crest.config.testbed_config import AxisConfig
-from crest.testbed_service import ServedTestbed, running_testbed
+from crest.testbed_service import ServedTestbed, config_digest, running_testbed
 from crest.testbed_service.served_bus import ServedBus
 
 _channel_numbers = itertools.count(1)
@@ -128,9 +128,11 @@ def join_bus(config: TestbedConfig) -> can.BusABC:
 
 
 def _join_served(config: TestbedConfig, served: ServedTestbed) -> can.BusABC:
-    if Path(served.config).resolve() != Path(config.path).resolve():
-        raise BackendError(f"the served virtual testbed ({served.describe()}) serves the drives of {served.config}, "
-                           f"not of {config.path}; use --config {served.config}, or stop it and serve {config.path}")
+    if served.config_digest != config_digest(config):
+        where = "" if Path(served.config).resolve() == Path(config.path).resolve() else f", not of {config.path}"
+        raise BackendError(f"the served virtual testbed ({served.describe()}) serves the drives of {served.config} "
+                           f"as it was when the testbed started{where}; this command runs with other values. "
+                           f"Use --config {served.config} unchanged, or stop the testbed and serve this configuration")
     try:
         return ServedBus(served.bus_channel, bitrate=config.bus.bitrate)
     except (can.CanError, OSError) as exc:

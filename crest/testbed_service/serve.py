@@ -14,7 +14,7 @@ from pathlib import Path
 
 from crest.backend import serve_virtual_testbed
 from crest.config import TestbedConfig
-from crest.testbed_service.state_file import ServedTestbed, claim_serving, state_path
+from crest.testbed_service.state_file import ServedTestbed, claim_serving, config_digest, state_path
 
 
 def serve_until_stopped(config: TestbedConfig, *, plant_config: Path | None = None, effects: dict | None = None,
@@ -28,7 +28,7 @@ def serve_until_stopped(config: TestbedConfig, *, plant_config: Path | None = No
         try:
             served = ServedTestbed(pid=os.getpid(), bus_interface=server.bus_interface,
                                    bus_channel=server.bus_channel, tracker_port=server.tracker_port,
-                                   config=str(Path(config.path).resolve()))
+                                   config=str(Path(config.path).resolve()), config_digest=config_digest(config))
             publish(served)
             on_ready(served, state_path())
             while True:

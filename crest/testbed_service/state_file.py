@@ -4,7 +4,10 @@
 writes ``testbed.json`` beside it::
 
     {"pid": 4242, "bus_interface": "remote", "bus_channel": "ws://127.0.0.1:40123/",
-     "tracker_port": "/dev/pts/7", "config": "/path/to/testbed.toml"}
+     "tracker_port": "/dev/pts/7", "config": "/path/to/testbed.toml", "config_digest": "9f2c..."}
+
+``config_digest`` is `config_digest(config)` of the configuration the testbed was built from: a
+command joins only a testbed built from the configuration it runs with, to the last value.
 
 The kernel releases the lock when the server ends, however it ends (kill -9 included). A state
 file whose lock nobody holds is therefore stale, left by a killed server: the other commands
@@ -15,6 +18,7 @@ The folder is ``$XDG_RUNTIME_DIR/crest``, or ``<temp dir>/crest-<uid>`` where th
 from __future__ import annotations
 
 import fcntl
+import hashlib
 import json
 import os
 import tempfile
@@ -39,6 +43,7 @@ class ServedTestbed:
     bus_channel: str
     tracker_port: str
     config: str
+    config_digest: str
 
     def describe(self) -> str:
         return (f"pid {self.pid}, CAN bus interface '{self.bus_interface}' channel '{self.bus_channel}', "
@@ -49,6 +54,16 @@ class TestbedAlreadyServed(RuntimeError):
     """A second server was asked for while one runs (the message names it and how to stop it)."""
 
     __test__ = False  # not a pytest test class despite the name
+
+
+def config_digest(config) -> str:
+    """SHA-256 (hex) of a TestbedConfig's values: its `as_dict()` with keys sorted, without the
+    file's own path, and with the EDS paths resolved (a file named two ways is the same file)."""
+    values = config.as_dict()
+    del values["path"]
+    for axis in values["axes"]:
+        axis["eds_path"] = str(Path(axis["eds_path"]).resolve())
+    return hashlib.sha256(json.dumps(values, sort_keys=True).encode()).hexdigest()
 
 
 def state_dir() -> Path:

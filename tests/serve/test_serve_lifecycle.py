@@ -49,3 +49,19 @@ def test_a_killed_server_leaves_a_stale_state_file_that_nothing_joins_and_the_ne
     finally:
         stop(second.process)
     assert second.process.returncode == ExitCode.OK
+
+
+def test_commands_that_cannot_join_the_served_testbed_refuse_and_leave_it_alone(tmp_path):
+    served = start_served_testbed(tmp_path)
+    try:
+        other_config = served.crest("status")        # configs/testbed.toml: other heartbeat timings
+        assert other_config.returncode == ExitCode.ERROR and other_config.stdout == ""
+        assert "serves the drives of" in other_config.stderr and "--config" in other_config.stderr
+        with_fault = served.crest("run", "builtin:circle", "--config", str(served.config),
+                                  "--fault", "tendon1:emcy@1.0")
+        assert with_fault.returncode == ExitCode.ERROR and "--fault" in crest_lines(with_fault.stderr)[0]
+        assert "a served one is running" in with_fault.stderr
+        assert served.process.poll() is None
+    finally:
+        stop(served.process)
+    assert served.process.returncode == ExitCode.OK
