@@ -6,7 +6,9 @@ This is the one place in crest that may import sim_backend. Everything above it 
 The virtual testbed ([bus] interface = "virtual") is found in one of two places. When a served
 one runs (`crest testbed serve`, its own process; see crest.testbed_service), the commands join it
 through python-can's "remote" interface on the channel its state file names, as they would join a
-hardware bus. Otherwise a command boots its own, inside its process, on the in-process bus.
+hardware bus. Otherwise a command boots its own: inside its process, on the in-process bus, or,
+with CREST_VIRTUAL_TESTBED=process, in a served testbed process of its own that ends with it
+(crest.testbed_service.auto_start).
 """
 from __future__ import annotations
 
@@ -18,9 +20,10 @@ from pathlib import Path
 
 import can
 
-from crest.config import TestbedConfig
+from crest.config import TestbedConfig, load_testbed_config
 from crest.config.testbed_config import AxisConfig
 from crest.testbed_service import ServedTestbed, config_digest, running_testbed
+from crest.testbed_service.auto_start import OwnedTestbed, start_owned_testbed, wants_own_process
 from crest.testbed_service.served_bus import ServedBus
 
 _channel_numbers = itertools.count(1)
@@ -39,6 +42,7 @@ class Backend:
     tracker_port: str
     virtual: object | None = None   # sim_backend.VirtualTestbed when simulated in this process
     served: ServedTestbed | None = None   # the served virtual testbed this process joined
+    owned: OwnedTestbed | None = None     # ... when this process started it for itself
 
     @property
     def is_virtual(self) -> bool:
@@ -67,6 +71,8 @@ class Backend:
         self.bus.shutdown()
         if self.virtual is not None:
             self.virtual.stop()
+        if self.owned is not None:
+            self.owned.stop()
 
 
 def fault_kinds() -> dict[str, tuple[str, ...]]:
@@ -104,6 +110,18 @@ def open_backend(config: TestbedConfig, *, plant: str | None = None, plant_confi
                                f"set up a virtual testbed when it starts, but a served one is running ({served.describe()}); "
                                "stop it, or pass them to `crest testbed serve`, or drop them")
         return Backend(bus=_join_served(config, served), tracker_port=served.tracker_port, served=served)
+    if (realtime and wants_own_process() and not (plant or faults or tracker_noise_mm is not None
+                                                  or tracker_dropout is not None)
+            and config_digest(load_testbed_config(config.path)) == config_digest(config)):
+        # a testbed process of our own (its file's values: a configuration changed in memory, and
+        # --plant, --fault and the tracker settings, which serve does not take, stay in-process)
+        owned = start_owned_testbed(config.path, plant_config, effects or {})
+        try:
+            bus = _join_served(config, owned.served)
+        except BackendError:
+            owned.stop()
+            raise
+        return Backend(bus=bus, tracker_port=owned.served.tracker_port, served=owned.served, owned=owned)
     return _open_virtual(config, plant, plant_config, faults, effects or {}, realtime, plant_in_thread,
                          tracker_noise_mm, tracker_dropout)
 

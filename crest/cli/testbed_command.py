@@ -31,6 +31,7 @@ def add_parser(sub) -> None:
                        help="switch on an unmodelled effect in the plant (repeatable), as for the other commands")
     serve.add_argument("--port", type=int, default=0,
                        help="TCP port of the CAN bus server on 127.0.0.1 (default 0: any free port)")
+    serve.add_argument("--parent-fd", type=int, default=None, help=argparse.SUPPRESS)   # auto_start.py's pipe
     parser.set_defaults(handler=run)
 
 
@@ -39,7 +40,7 @@ def run(args: argparse.Namespace) -> int:
     effects = dict(parse_effect(text) for text in args.effect)
     try:
         serve_until_stopped(config, plant_config=args.plant_config, effects=effects, port=args.port,
-                            on_ready=_announce)
+                            on_ready=_announce, parent_fd=args.parent_fd)
     except TestbedAlreadyServed as exc:
         print(f"crest testbed serve: {exc}", file=sys.stderr)
         return int(ExitCode.ERROR)
