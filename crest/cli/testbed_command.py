@@ -10,7 +10,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from crest.cli.common_options import parse_effect
+from crest.cli.common_options import add_debug_option, parse_effect
 from crest.config import load_testbed_config
 from crest.driver import Terminated
 from crest.exit_codes import ExitCode
@@ -29,10 +29,22 @@ def add_parser(sub) -> None:
                        help="the plant description (default configs/virtual_plant.toml)")
     serve.add_argument("--effect", action="append", default=[], metavar="ID[:NAME=VALUE,...]",
                        help="switch on an unmodelled effect in the plant (repeatable), as for the other commands")
-    serve.add_argument("--port", type=int, default=0,
+    serve.add_argument("--port", type=_tcp_port, default=0,
                        help="TCP port of the CAN bus server on 127.0.0.1 (default 0: any free port)")
     serve.add_argument("--parent-fd", type=int, default=None, help=argparse.SUPPRESS)   # auto_start.py's pipe
+    add_debug_option(serve)
     parser.set_defaults(handler=run)
+
+
+def _tcp_port(text: str) -> int:
+    """argparse type: a TCP port number, 0-65535 (0: any free port)."""
+    try:
+        port = int(text)
+    except ValueError:
+        port = -1
+    if not 0 <= port <= 65535:
+        raise argparse.ArgumentTypeError(f"expected a TCP port 0-65535 (0: any free port), got {text!r}")
+    return port
 
 
 def run(args: argparse.Namespace) -> int:
