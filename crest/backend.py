@@ -110,20 +110,25 @@ def open_backend(config: TestbedConfig, *, plant: str | None = None, plant_confi
                                f"set up a virtual testbed when it starts, but a served one is running ({served.describe()}); "
                                "stop it, or pass them to `crest testbed serve`, or drop them")
         return Backend(bus=_join_served(config, served), tracker_port=served.tracker_port, served=served)
-    if (realtime and wants_own_process() and not (plant or faults or tracker_noise_mm is not None
+    # serve takes the plant description and effects only; a configuration changed in memory (not
+    # its file's values) cannot be handed to a testbed process either: those stay in this process
+    if (realtime and wants_own_process() and not (plant or faults or plant_in_thread or tracker_noise_mm is not None
                                                   or tracker_dropout is not None)
             and config_digest(load_testbed_config(config.path)) == config_digest(config)):
-        # a testbed process of our own (its file's values: a configuration changed in memory, and
-        # --plant, --fault and the tracker settings, which serve does not take, stay in-process)
-        owned = start_owned_testbed(config.path, plant_config, effects or {})
-        try:
-            bus = _join_served(config, owned.served)
-        except BackendError:
-            owned.stop()
-            raise
-        return Backend(bus=bus, tracker_port=owned.served.tracker_port, served=owned.served, owned=owned)
+        return _open_owned(config, plant_config, effects or {})
     return _open_virtual(config, plant, plant_config, faults, effects or {}, realtime, plant_in_thread,
                          tracker_noise_mm, tracker_dropout)
+
+
+def _open_owned(config: TestbedConfig, plant_config: Path | None, effects: dict) -> Backend:
+    """A served testbed process of this command's own, joined (it ends when this process does)."""
+    owned = start_owned_testbed(config.path, plant_config, effects)
+    try:
+        bus = _join_served(config, owned.served)
+    except BackendError:
+        owned.stop()
+        raise
+    return Backend(bus=bus, tracker_port=owned.served.tracker_port, served=owned.served, owned=owned)
 
 
 def join_bus(config: TestbedConfig) -> can.BusABC:
