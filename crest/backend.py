@@ -2,6 +2,13 @@
 
 This is the one place in crest that may import sim_backend. Everything above it talks to a
 `can.BusABC` and a serial port name, and never asks which it got.
+
+The virtual testbed ([bus] interface = "virtual") is found in one of two places. When a served
+one runs (`crest testbed serve`, its own process; see crest.testbed_service), the commands join it
+through python-can's "remote" interface on the channel its state file names, as they would join a
+hardware bus. Otherwise a command boots its own: inside its process, on the in-process bus, or,
+with CREST_VIRTUAL_TESTBED=process, in a served testbed process of its own that ends with it
+(crest.testbed_service.auto_start).
 """
 from __future__ import annotations
 
@@ -13,8 +20,11 @@ from pathlib import Path
 
 import can
 
-from crest.config import TestbedConfig
+from crest.config import TestbedConfig, load_testbed_config
 from crest.config.testbed_config import AxisConfig
+from crest.testbed_service import ServedTestbed, config_digest, running_testbed
+from crest.testbed_service.auto_start import OwnedTestbed, start_owned_testbed, wants_own_process
+from crest.testbed_service.served_bus import ServedBus
 
 _channel_numbers = itertools.count(1)
 INSERTION_START_ABOVE_HOME_MM = 2.0   # the simulated pulley block powers up this far from its switch
@@ -30,14 +40,18 @@ class Backend:
 
     bus: can.BusABC
     tracker_port: str
-    virtual: object | None = None   # sim_backend.VirtualTestbed when simulated
+    virtual: object | None = None   # sim_backend.VirtualTestbed when simulated in this process
+    served: ServedTestbed | None = None   # the served virtual testbed this process joined
+    owned: OwnedTestbed | None = None     # ... when this process started it for itself
 
     @property
     def is_virtual(self) -> bool:
-        return self.virtual is not None
+        return self.virtual is not None or self.served is not None
 
     def monitor_bus(self) -> can.BusABC | None:
-        """A second handle that sees every frame on the bus, the host's included (virtual bus only)."""
+        """A second handle that sees every frame on the bus, the host's included (virtual testbed only)."""
+        if self.served is not None:
+            return ServedBus(self.served.bus_channel)
         if self.virtual is None:
             return None
         return can.Bus(interface="virtual", channel=self.virtual.channel)
@@ -57,6 +71,8 @@ class Backend:
         self.bus.shutdown()
         if self.virtual is not None:
             self.virtual.stop()
+        if self.owned is not None:
+            self.owned.stop()
 
 
 def fault_kinds() -> dict[str, tuple[str, ...]]:
@@ -87,23 +103,64 @@ def open_backend(config: TestbedConfig, *, plant: str | None = None, plant_confi
             raise BackendError(f"{config.path}: [tracker].port = 'sim' needs the virtual testbed; "
                                "set it to the tracker's serial device")
         return Backend(bus=_open_hardware_bus(config), tracker_port=config.tracker.port)
+    served = running_testbed() if realtime else None
+    if served is not None:
+        if plant or plant_config or faults or effects or tracker_noise_mm is not None or tracker_dropout is not None:
+            raise BackendError("--plant, --plant-config, --fault, --effect and the tracker's noise and dropout "
+                               f"set up a virtual testbed when it starts, but a served one is running ({served.describe()}); "
+                               "stop it, or pass them to `crest testbed serve`, or drop them")
+        return Backend(bus=_join_served(config, served), tracker_port=served.tracker_port, served=served)
+    # serve takes the plant description and effects only; a configuration changed in memory (not
+    # its file's values) cannot be handed to a testbed process either: those stay in this process
+    if (realtime and wants_own_process() and not (plant or faults or plant_in_thread or tracker_noise_mm is not None
+                                                  or tracker_dropout is not None)
+            and config_digest(load_testbed_config(config.path)) == config_digest(config)):
+        return _open_owned(config, plant_config, effects or {})
     return _open_virtual(config, plant, plant_config, faults, effects or {}, realtime, plant_in_thread,
                          tracker_noise_mm, tracker_dropout)
+
+
+def _open_owned(config: TestbedConfig, plant_config: Path | None, effects: dict) -> Backend:
+    """A served testbed process of this command's own, joined (it ends when this process does)."""
+    owned = start_owned_testbed(config.path, plant_config, effects)
+    try:
+        bus = _join_served(config, owned.served)
+    except BackendError:
+        owned.stop()
+        raise
+    return Backend(bus=bus, tracker_port=owned.served.tracker_port, served=owned.served, owned=owned)
 
 
 def join_bus(config: TestbedConfig) -> can.BusABC:
     """A handle on the CAN bus of `config` for a process beside the master (``crest estop``).
 
-    Only a hardware bus can be joined: the drives of the virtual testbed live inside the crest
-    process that started them, on its in-process bus, and no other process can reach them. Opening
-    a virtual testbed here would boot drives of our own and reach nobody's, so it is refused
-    (BackendError). The tracker is not opened, so its [tracker].port does not matter.
+    A hardware bus, or the bus of a served virtual testbed (`crest testbed serve`). A virtual
+    testbed booted inside a crest process lives on that process's in-process bus, which no other
+    process can reach: without a served testbed this raises BackendError (opening a virtual testbed
+    here would boot drives of our own and reach nobody's). The tracker is not opened.
     """
-    if config.bus.interface == "virtual":
+    if config.bus.interface != "virtual":
+        return _open_hardware_bus(config)
+    served = running_testbed()
+    if served is None:
         raise BackendError(f"the virtual testbed ({config.path}: [bus] interface = 'virtual') runs inside the "
                            "crest process that started it; another process cannot reach its drives. "
-                           "Stop that run with Ctrl-C (or SIGTERM)")
-    return _open_hardware_bus(config)
+                           "Stop that run with Ctrl-C (or SIGTERM). To reach the virtual testbed from other processes, "
+                           "run it on its own: `crest testbed serve`")
+    return _join_served(config, served)
+
+
+def _join_served(config: TestbedConfig, served: ServedTestbed) -> can.BusABC:
+    if served.config_digest != config_digest(config):
+        where = "" if Path(served.config).resolve() == Path(config.path).resolve() else f", not of {config.path}"
+        raise BackendError(f"the served virtual testbed ({served.describe()}) serves the drives of {served.config} "
+                           f"as it was when the testbed started{where}; this command runs with other values. "
+                           f"Use --config {served.config} unchanged, or stop the testbed and serve this configuration")
+    try:
+        return ServedBus(served.bus_channel, bitrate=config.bus.bitrate)
+    except (can.CanError, OSError) as exc:
+        raise BackendError(f"cannot join the served virtual testbed ({served.describe()}): {exc}. "
+                           "Is it still starting, or stuck? Stop it and start it again") from exc
 
 
 def _open_hardware_bus(config: TestbedConfig) -> can.BusABC:
@@ -117,6 +174,54 @@ def _open_hardware_bus(config: TestbedConfig) -> can.BusABC:
 def _open_virtual(config: TestbedConfig, plant_spec: str | None, plant_toml: Path | None, fault_texts: Sequence[str],
                   effects: dict, realtime: bool, plant_in_thread: bool, tracker_noise_mm: float | None,
                   tracker_dropout: float | None) -> Backend:
+    # The virtual bus is in-process: a channel of our own per testbed keeps testbeds apart.
+    channel = f"{config.bus.channel}-{os.getpid()}-{next(_channel_numbers)}"
+    testbed = _virtual_testbed(config, channel, plant_spec, plant_toml, fault_texts, effects, plant_in_thread,
+                               tracker_noise_mm, tracker_dropout)
+    testbed.start(realtime=realtime)
+    bus = can.Bus(interface="virtual", channel=channel, receive_own_messages=False)
+    return Backend(bus=bus, tracker_port=testbed.tracker_port, virtual=testbed)
+
+
+@dataclass
+class VirtualTestbedServer:
+    """A virtual testbed running in this process with its bus served to other processes."""
+
+    bus_interface: str      # the python-can interface and channel other processes open
+    bus_channel: str
+    tracker_port: str
+    testbed: object         # sim_backend.VirtualTestbed
+    server: object          # sim_backend.bus_server.BusServer
+
+    def stop(self) -> None:
+        self.server.stop()
+        self.testbed.stop()
+
+
+def serve_virtual_testbed(config: TestbedConfig, *, plant_config: Path | None = None, effects: dict | None = None,
+                          port: int = 0) -> VirtualTestbedServer:
+    """Start the virtual testbed of `config` (real time) and serve its CAN bus on 127.0.0.1:port
+    (0: any free port) over python-can-remote. plant_config and effects as for `open_backend`."""
+    from sim_backend.bus_server import BusServer
+
+    if config.bus.interface != "virtual":
+        raise BackendError(f"{config.path} selects the real bus '{config.bus.interface}'; only the virtual testbed "
+                           "([bus] interface = 'virtual') can be served")
+    channel = f"{config.bus.channel}-served-{os.getpid()}"
+    testbed = _virtual_testbed(config, channel, None, plant_config, (), effects or {}, False, None, None)
+    testbed.start(realtime=True)
+    try:
+        server = BusServer(channel, port).start()
+    except OSError as exc:
+        testbed.stop()
+        raise BackendError(f"cannot serve the virtual testbed's bus on 127.0.0.1:{port}: {exc}; "
+                           "choose another --port (0 picks a free one)") from exc
+    return VirtualTestbedServer("remote", server.url, testbed.tracker_port, testbed, server)
+
+
+def _virtual_testbed(config: TestbedConfig, channel: str, plant_spec: str | None, plant_toml: Path | None,
+                     fault_texts: Sequence[str], effects: dict, plant_in_thread: bool,
+                     tracker_noise_mm: float | None, tracker_dropout: float | None):
     from sim_backend.faults import parse_fault
     from sim_backend.plant import load_plant
     from sim_backend.plant.plant_description import load_plant_description
@@ -126,18 +231,13 @@ def _open_virtual(config: TestbedConfig, plant_spec: str | None, plant_toml: Pat
     described_plant, tracker = load_plant_description(plant_toml, effects)
     plant = load_plant(plant_spec) if plant_spec else described_plant
     specs = [_drive_spec(config, axis) for axis in config.axes]
-    # The virtual bus is in-process: a channel of our own per testbed keeps testbeds apart.
-    channel = f"{config.bus.channel}-{os.getpid()}-{next(_channel_numbers)}"
-    testbed = VirtualTestbed(specs, channel, plant, bitrate_bit_s=config.bus.bitrate,
-                             sync_period_s=config.sync.period_s, faults=faults, faults_wait_for_run=True,
-                             tracker=TrackerSettings(
-                                 tracker.noise_mm if tracker_noise_mm is None else tracker_noise_mm,
-                                 tracker.dropout if tracker_dropout is None else tracker_dropout,
-                                 tracker.seed, int(config.tracker.tool_port, 16)),
-                             plant_in_thread=plant_in_thread)
-    testbed.start(realtime=realtime)
-    bus = can.Bus(interface="virtual", channel=channel, receive_own_messages=False)
-    return Backend(bus=bus, tracker_port=testbed.tracker_port, virtual=testbed)
+    return VirtualTestbed(specs, channel, plant, bitrate_bit_s=config.bus.bitrate,
+                          sync_period_s=config.sync.period_s, faults=faults, faults_wait_for_run=True,
+                          tracker=TrackerSettings(
+                              tracker.noise_mm if tracker_noise_mm is None else tracker_noise_mm,
+                              tracker.dropout if tracker_dropout is None else tracker_dropout,
+                              tracker.seed, int(config.tracker.tool_port, 16)),
+                          plant_in_thread=plant_in_thread)
 
 
 def _drive_spec(config: TestbedConfig, axis: AxisConfig):

@@ -1,9 +1,10 @@
-"""`crest estop`: quick-stop every drive of a hardware testbed now, by SDO, from a second process.
+"""`crest estop`: quick-stop every drive now, by SDO, from a second process.
 
+It reaches the drives of a hardware testbed, or of a served virtual testbed (`crest testbed serve`).
 One line per axis on stdout. Success (exit 0) only when every axis answered and no longer shows
 OPERATION ENABLED; an axis that could not be reached or did not stop fails the command (exit 1)
-with one line on stderr naming the axes. On the virtual testbed there is nothing another process
-can reach, so estop refuses (exit 1) without opening anything.
+with one line on stderr naming the axes. A virtual testbed inside another crest process is out of
+reach of any other process, so estop refuses it (exit 1) without opening anything.
 """
 from __future__ import annotations
 
@@ -18,7 +19,7 @@ from crest.exit_codes import ExitCode
 
 
 def add_parser(sub) -> None:
-    parser = sub.add_parser("estop", help="quick-stop every drive of a hardware testbed (beside a running crest)")
+    parser = sub.add_parser("estop", help="quick-stop every drive of a hardware or served virtual testbed (beside a running crest)")
     parser.add_argument("--config", type=Path, default=None,
                         help="the testbed configuration of the running testbed (its [bus]; the tracker is not used)")
     parser.set_defaults(handler=run)

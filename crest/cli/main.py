@@ -10,7 +10,7 @@ import sys
 
 from crest.cli import (bench_command, demo_command, estop_command, excite_command, fit_command, gap_command,
                        home_command, jog_command, move_command, paper_command, run_command, status_command,
-                       view_command)
+                       testbed_command, view_command)
 from crest.cli.common_options import add_debug_option
 from crest.cli.compile_notice import announce_compiles
 from crest.cli.library_logging import route_library_logging
@@ -32,6 +32,7 @@ COMMANDS = {
     "fit": fit_command,
     "gap": gap_command,
     "view": view_command,
+    "testbed": testbed_command,
 }
 
 

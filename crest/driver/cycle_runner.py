@@ -112,8 +112,9 @@ class CycleRunner:
         return self.last_sample
 
     def _check(self, now_s: float, fresh: tuple[bool, ...], latched: list[int | None]) -> None:
-        for name, silent_s in self.heartbeats.silent_axes(now_s):
-            self.monitor.trip(heartbeat_cause(name, silent_s, self.heartbeats.timeout_s))
+        if self.heartbeats.silent_axes(now_s):
+            self.monitor.trip(heartbeat_cause(self.heartbeats.silent_axes(now_s, self.heartbeats.timeout_s / 2.0),
+                                              self.heartbeats.timeout_s))
         for axis, is_fresh, latched_counts in zip(self.axes, fresh, latched):
             if is_fresh:
                 cause = feedback_fault(axis, latched_counts)

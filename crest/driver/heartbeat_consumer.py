@@ -71,11 +71,13 @@ class HeartbeatConsumer:
         with self._changed:
             self._last_seen_s = {}
 
-    def silent_axes(self, now_s: float) -> list[tuple[str, float]]:
-        """(axis, seconds since its last heartbeat) for every watched drive silent longer than the timeout."""
+    def silent_axes(self, now_s: float, longer_than_s: float | None = None) -> list[tuple[str, float]]:
+        """(axis, seconds since its last heartbeat), the longest silence first, for every watched
+        drive silent longer than ``longer_than_s`` (default: the timeout)."""
+        limit_s = self.timeout_s if longer_than_s is None else longer_than_s
         with self._changed:
-            return [(axis, now_s - seen_s) for axis, seen_s in self._last_seen_s.items()
-                    if now_s - seen_s > self.timeout_s]
+            silences = [(axis, now_s - seen_s) for axis, seen_s in self._last_seen_s.items() if now_s - seen_s > limit_s]
+        return sorted(silences, key=lambda silence: -silence[1])
 
     def nmt_state(self, axis: str) -> str:
         """The NMT state of the drive's last boot-up or heartbeat ("UNKNOWN" if none was seen)."""

@@ -10,6 +10,7 @@ code -> EMCY. 0x0000 (error reset) is not a fault.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import can
 from canopen.emcy import EmcyError
@@ -66,9 +67,18 @@ def error_frame_cause(message: can.Message) -> StopCause:
                                                 "termination and that every node uses the same bitrate")
 
 
-def heartbeat_cause(axis: str, silent_s: float, timeout_s: float) -> StopCause:
-    return StopCause(ExitCode.HEARTBEAT_LOST, axis, f"no heartbeat for {silent_s:.3f} s (limit {timeout_s:g} s); "
-                                                    "check the drive's power and CAN connection")
+def heartbeat_cause(silences: Sequence[tuple[str, float]], timeout_s: float) -> StopCause:
+    """The drives that went silent together, as (axis, seconds since its last heartbeat), the
+    longest silence first: one drive is one lost drive; several at once (a bus or a power supply
+    gone) are named together."""
+    if len(silences) == 1:
+        axis, silent_s = silences[0]
+        return StopCause(ExitCode.HEARTBEAT_LOST, axis, f"no heartbeat for {silent_s:.3f} s (limit {timeout_s:g} s); "
+                                                        "check the drive's power and CAN connection")
+    seconds = [silent_s for _, silent_s in silences]
+    return StopCause(ExitCode.HEARTBEAT_LOST, ", ".join(axis for axis, _ in silences),
+                     f"no heartbeat from {len(silences)} drives at once for {min(seconds):.3f}-{max(seconds):.3f} s "
+                     f"(limit {timeout_s:g} s); check the drives' power and the CAN connection")
 
 
 def tension_cause(axis: str, tension_n: float, limit_n: float) -> StopCause:

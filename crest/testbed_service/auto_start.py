@@ -1,0 +1,92 @@
+"""A served virtual testbed started for one command and stopped with it.
+
+With ``CREST_VIRTUAL_TESTBED=process`` in the environment, a command that finds no served testbed
+starts `crest testbed serve` as its child, joins it like any served testbed (so `crest estop` and
+`crest status` reach it from other processes), and stops it when the command ends. The child holds
+the read end of a pipe whose only writer is the command: when the command ends, however it ends
+(a crash, kill -9), the kernel closes the pipe and the child stops itself (serve.py). Without the
+variable, or with ``CREST_VIRTUAL_TESTBED=in-process`` (the default for now), a command boots the
+virtual testbed inside its own process.
+"""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from crest.testbed_service.state_file import ServedTestbed, running_testbed
+
+MODE_VARIABLE = "CREST_VIRTUAL_TESTBED"
+MODES = ("in-process", "process")
+START_TIMEOUT_S = 300.0     # a first start in a fresh install compiles the plant's kernels
+STOP_TIMEOUT_S = 30.0
+
+
+class AutoStartError(RuntimeError):
+    """The testbed process could not be started (the message holds its own last words)."""
+
+
+def wants_own_process() -> bool:
+    """True when CREST_VIRTUAL_TESTBED asks for the virtual testbed in a process of its own."""
+    mode = os.environ.get(MODE_VARIABLE, "in-process")
+    if mode not in MODES:
+        raise ValueError(f"{MODE_VARIABLE}={mode!r}: expected one of {', '.join(MODES)}")
+    return mode == "process"
+
+
+@dataclass
+class OwnedTestbed:
+    """The testbed process a command started, and the command's end of the pipe it watches."""
+
+    process: subprocess.Popen
+    pipe_fd: int
+    served: ServedTestbed
+
+    def stop(self) -> None:
+        """Close the pipe (the testbed stops itself) and wait for the process; kill it if it hangs."""
+        if self.pipe_fd >= 0:
+            os.close(self.pipe_fd)
+            self.pipe_fd = -1
+        try:
+            self.process.wait(timeout=STOP_TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()
+
+
+def start_owned_testbed(config_path: Path, plant_config: Path | None, effects: dict) -> OwnedTestbed:
+    """`crest testbed serve` as a child of this process, returned once it serves (AutoStartError if
+    it cannot start, e.g. because another testbed took the lock in the meantime)."""
+    read_fd, write_fd = os.pipe()
+    os.set_inheritable(read_fd, True)
+    command = [sys.executable, "-m", "crest.cli.main", "testbed", "serve", "--config", str(config_path),
+               "--parent-fd", str(read_fd)]
+    if plant_config is not None:
+        command += ["--plant-config", str(plant_config)]
+    for effect_id, values in effects.items():
+        command += ["--effect", effect_id + (":" + ",".join(f"{name}={value!r}" for name, value in values.items())
+                                             if values else "")]
+    with tempfile.TemporaryFile("w+") as output:
+        try:
+            process = subprocess.Popen(command, pass_fds=(read_fd,), stdin=subprocess.DEVNULL,
+                                       stdout=subprocess.DEVNULL, stderr=output, start_new_session=True)
+        finally:
+            os.close(read_fd)
+        owned = OwnedTestbed(process, write_fd, None)
+        deadline_s = time.monotonic() + START_TIMEOUT_S
+        while True:
+            served = running_testbed()
+            if served is not None and served.pid == process.pid:
+                owned.served = served
+                return owned
+            if process.poll() is not None or time.monotonic() > deadline_s:
+                owned.stop()
+                output.seek(0)
+                last_words = " | ".join(output.read().strip().splitlines()[-3:])
+                raise AutoStartError(f"the virtual testbed's own process did not start ({last_words or 'no output'}); "
+                                     f"unset {MODE_VARIABLE} to run it inside this command")
+            time.sleep(0.1)

@@ -1,0 +1,53 @@
+"""Serving the virtual testbed as its own process, until it is told to stop.
+
+One server per user: `claim_serving` takes the lock (a second server is refused), the testbed
+starts, its state file says where its bus and tracker are, and the process waits for a signal.
+Ctrl-C (SIGINT) and SIGTERM end the wait: the bus server closes every client's connection, the
+drives and the tracker stop, and the state file is removed before the lock is released.
+
+A testbed started for one command (auto_start.py) also watches a pipe from that command: the
+kernel closes it when the command ends, however it ends (kill -9 included), and the end of the
+pipe stops the testbed as SIGTERM does, so no testbed outlives the command that started it.
+"""
+from __future__ import annotations
+
+import os
+import signal
+import threading
+from collections.abc import Callable
+from pathlib import Path
+
+from crest.backend import serve_virtual_testbed
+from crest.config import TestbedConfig
+from crest.testbed_service.state_file import ServedTestbed, claim_serving, config_digest, state_path
+
+
+def serve_until_stopped(config: TestbedConfig, *, plant_config: Path | None = None, effects: dict | None = None,
+                        port: int = 0, on_ready: Callable[[ServedTestbed, Path], None] = lambda served, path: None,
+                        parent_fd: int | None = None) -> None:
+    """Serve the virtual testbed of `config` until a signal's handler raises (KeyboardInterrupt
+    for SIGINT, crest.driver.Terminated for SIGTERM); that exception propagates after the clean-up.
+    on_ready(served, state file) is called once the state file is written. parent_fd: the read end
+    of the starting command's pipe; its end sends this process SIGTERM."""
+    if parent_fd is not None:
+        threading.Thread(target=_terminate_when_closed, args=(parent_fd,), name="parent-pipe", daemon=True).start()
+    with claim_serving() as publish:
+        server = serve_virtual_testbed(config, plant_config=plant_config, effects=effects, port=port)
+        try:
+            served = ServedTestbed(pid=os.getpid(), bus_interface=server.bus_interface,
+                                   bus_channel=server.bus_channel, tracker_port=server.tracker_port,
+                                   config=str(Path(config.path).resolve()), config_digest=config_digest(config))
+            publish(served)
+            on_ready(served, state_path())
+            while True:
+                signal.pause()
+        finally:
+            server.stop()
+
+
+def _terminate_when_closed(fd: int) -> None:
+    """Read `fd` until its writer is gone, then SIGTERM this process."""
+    with os.fdopen(fd, "rb", buffering=0) as pipe:
+        while pipe.read(1):
+            pass
+    os.kill(os.getpid(), signal.SIGTERM)

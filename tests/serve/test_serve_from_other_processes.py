@@ -1,0 +1,131 @@
+"""A served virtual testbed reached from other processes, as drives on a real bus are: status and
+python-can's logger beside a run, estop from a second process, and kill -9 on either side.
+
+Every run here is a real-time `crest run` in its own process on the served testbed's bus
+(python-can interface "remote"); every other command is a process of its own as well.
+"""
+import json
+import re
+import signal
+import subprocess
+import sys
+import time
+
+import can
+import pytest
+
+from crest.exit_codes import ExitCode
+from crest.log import read_log
+from served_testbed import (HEARTBEAT_TIMEOUT_S, crest_lines, rows_on_disk, start_run, start_served_testbed,
+                            status_rows, stop, wait_for_rows)
+from tests.cli.cli_runner import REPO
+
+AXES = ("tendon1", "tendon2", "tendon3", "tendon4", "insertion")
+NODE_IDS = (1, 2, 3, 4, 5)
+QUICK_STOP_SDO = bytes([0x2B, 0x40, 0x60, 0x00, 0x02, 0x00])   # expedited download: 0x6040:00 = 0x0002
+
+
+@pytest.fixture
+def served(tmp_path):
+    """A testbed of the test's own: the plant keeps its state between commands, as a real catheter
+    does (a run stopped mid-circle leaves it bent, and tendon homing adopts that as zero)."""
+    served = start_served_testbed(tmp_path / "served")
+    try:
+        yield served
+    finally:
+        stop(served.process)
+
+
+def test_status_and_the_can_logger_watch_a_run_from_other_processes_without_disturbing_it(served, tmp_path):
+    log_path = tmp_path / "run.csv"
+    run = start_run(served, log_path)
+    logger_out = tmp_path / "logger.txt"
+    with logger_out.open("w") as sink:
+        logger = subprocess.Popen([sys.executable, "-m", "can.logger", "-i", "remote", "-c", served.state["bus_channel"]],
+                                  stdout=sink, stderr=subprocess.STDOUT, cwd=REPO)
+    try:
+        status = served.crest("status", "--config", str(served.config))
+        assert status.returncode == ExitCode.OK, status.stderr
+        rows = status_rows(status.stdout)
+        assert list(rows) == list(AXES)
+        for axis, fields in rows.items():       # the live states of the running drives, not reset ones
+            assert fields[1:3] == ["OPERATIONAL", "OPERATION_ENABLED"], (axis, status.stdout)
+        ids_seen = set()
+        deadline = time.monotonic() + 120
+        while not {0x80, *(0x180 + n for n in NODE_IDS), *(0x200 + n for n in NODE_IDS)} <= ids_seen:
+            assert logger.poll() is None and time.monotonic() < deadline, logger_out.read_text()[-2000:]
+            ids_seen = {int(found, 16) for found in re.findall(r"ID:\s+([0-9a-f]+)\s", logger_out.read_text())}
+            time.sleep(0.2)
+        # The run went on: still running, still writing rows; Ctrl-C, not the observers, ends it.
+        wait_for_rows(log_path, rows_on_disk(log_path) + 20, run)
+        run.send_signal(signal.SIGINT)
+        _, stderr = run.communicate(timeout=120)
+        assert run.returncode == ExitCode.INTERRUPTED, stderr
+    finally:
+        stop(run)
+        logger.send_signal(signal.SIGINT)
+        try:
+            logger.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            logger.kill()
+            logger.wait()
+
+
+def test_estop_from_another_process_stops_every_axis_and_the_run_exits_with_its_stop_cause(served, tmp_path):
+    log_path = tmp_path / "run.csv"
+    run = start_run(served, log_path)
+    try:
+        estop = served.crest("estop", "--config", str(served.config))
+        _, stderr = run.communicate(timeout=120)
+    finally:
+        stop(run)
+    assert estop.returncode == ExitCode.OK, estop.stdout + estop.stderr
+    assert [line.split()[:2] for line in estop.stdout.splitlines()] == [[axis, "stopped"] for axis in AXES]
+    lines = crest_lines(stderr)
+    assert run.returncode == ExitCode.ERROR, stderr
+    assert len(lines) == 1 and "without a command from this host (crest estop" in lines[0], stderr
+    summary = json.loads(log_path.with_suffix(".json").read_text())["summary"]
+    assert summary["exit_code"] == ExitCode.ERROR and "crest estop" in summary["stop_cause"]
+    # The run's CAN recording, made through its own handle on the served bus, holds the estop's
+    # quick stop to tendon1, the first it stops: a frame another process sent. (The run stops
+    # itself on that first stopped axis and closes its recording while estop goes on.)
+    frames = list(can.LogReader(log_path.with_suffix(".blf")))
+    assert any(f.arbitration_id == 0x601 and bytes(f.data[:6]) == QUICK_STOP_SDO for f in frames)
+
+
+def test_kill_9_of_the_master_lets_every_served_drive_stop_on_the_lost_heartbeat(served, tmp_path):
+    run = start_run(served, tmp_path / "run.csv")
+    run.kill()
+    run.communicate()
+    deadline = time.monotonic() + 10 * HEARTBEAT_TIMEOUT_S + 120
+    while True:
+        status = served.crest("status", "--config", str(served.config))
+        rows = status_rows(status.stdout)
+        if list(rows) == list(AXES) and all(fields[2] == "FAULT" and fields[5] == "0x8130" for fields in rows.values()):
+            break                                # 0x8130: heartbeat lost, the drive stopped hearing the host
+        assert time.monotonic() < deadline, status.stdout + status.stderr
+        time.sleep(1.0)
+
+
+def test_kill_9_of_the_served_testbed_stops_the_run_on_every_axis_heartbeat_lost_with_its_log(tmp_path):
+    served = start_served_testbed(tmp_path)
+    log_path = tmp_path / "run.csv"
+    run = None
+    try:
+        run = start_run(served, log_path)
+        served.process.kill()                    # the drives, the plant and the tracker vanish at once
+        served.process.communicate()
+        _, stderr = run.communicate(timeout=120)
+    finally:
+        if run is not None:
+            stop(run)
+        stop(served.process)
+    assert run.returncode == ExitCode.HEARTBEAT_LOST, stderr
+    lines = crest_lines(stderr)
+    assert len(lines) == 1 and "HEARTBEAT_LOST" in lines[0] and "Traceback" not in stderr, stderr
+    named, _, reason = lines[0].partition(": no heartbeat from ")
+    assert sorted(named.split("(HEARTBEAT_LOST): ")[1].split(", ")) == sorted(AXES), lines[0]
+    assert reason.startswith("5 drives at once"), lines[0]
+    summary = json.loads(log_path.with_suffix(".json").read_text())["summary"]
+    assert summary["exit_code"] == ExitCode.HEARTBEAT_LOST and summary["stop_cause"] in lines[0]
+    assert len(read_log(log_path)) >= 20
