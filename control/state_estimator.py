@@ -30,8 +30,6 @@ import enum
 import math
 
 import numpy as np
-from filterpy.kalman import ExtendedKalmanFilter
-from scipy.stats import chi2
 
 from control.friction_sensitivity import ModelPrediction
 from control.tip_measurement import TipMeasurement
@@ -60,6 +58,11 @@ class TipEstimator:
                  scale_walk_per_s: float = 1e-3, initial_bias_sd_mm: float = 3.0, initial_scale_sd: float = 0.3,
                  gate_probability: float = 1e-3, max_sample_age_s: float = 0.1, reacquire_after: int = 3,
                  max_reacquire_mm: float = 10.0):
+        # Imported here, not with the module: filterpy imports scipy.stats and matplotlib (about a second),
+        # which only a controller that builds an estimator (dahl+fb) should pay at its start.
+        from filterpy.kalman import ExtendedKalmanFilter
+        from scipy.stats import chi2
+
         values = dict(tip_noise_mm=tip_noise_mm, tension_noise_n=tension_noise_n,
                       bias_walk_mm2_per_s=bias_walk_mm2_per_s, scale_walk_per_s=scale_walk_per_s,
                       initial_bias_sd_mm=initial_bias_sd_mm, initial_scale_sd=initial_scale_sd,

@@ -5,12 +5,10 @@ Every command runs on the virtual testbed unless --config names a real one.
 from __future__ import annotations
 
 import argparse
+import importlib
 import signal
 import sys
 
-from crest.cli import (bench_command, demo_command, estop_command, excite_command, fit_command, gap_command,
-                       home_command, jog_command, move_command, paper_command, run_command, status_command,
-                       testbed_command, view_command)
 from crest.cli.common_options import add_debug_option
 from crest.cli.compile_notice import announce_compiles
 from crest.cli.library_logging import route_library_logging
@@ -18,30 +16,27 @@ from crest.config import ConfigError
 from crest.driver import SafetyStop, Terminated
 from crest.exit_codes import ExitCode
 
-COMMANDS = {
-    "demo": demo_command,
-    "status": status_command,
-    "home": home_command,
-    "move": move_command,
-    "run": run_command,
-    "jog": jog_command,
-    "estop": estop_command,
-    "excite": excite_command,
-    "paper": paper_command,
-    "bench": bench_command,
-    "fit": fit_command,
-    "gap": gap_command,
-    "view": view_command,
-    "testbed": testbed_command,
-}
+COMMANDS = ("demo", "status", "home", "move", "run", "jog", "estop", "excite", "paper", "bench", "fit", "gap", "view",
+            "testbed")
+"""Each command is crest/cli/NAME_command.py: its add_parser(sub), which sets the handler."""
 
 
-def build_parser() -> argparse.ArgumentParser:
+def command_names(argv: list[str]) -> tuple[str, ...]:
+    """The commands whose modules a start imports: only the one argv names, else all of them (for
+    `crest --help` and for argparse's error that lists the choices). A command module imports what its
+    handler needs (numba's kernels, filterpy, bokeh, matplotlib, ...): all of them together cost
+    seconds at every start. The top level has no option that takes a value, so the first argument
+    that is not an option is the command."""
+    named = next((arg for arg in argv if not arg.startswith("-")), None)
+    return (named,) if named in COMMANDS else COMMANDS
+
+
+def build_parser(names: tuple[str, ...] = COMMANDS) -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="crest", description="CREST catheter testbed: driver, model, control.")
     add_debug_option(parser, default=False)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for name, module in COMMANDS.items():
-        module.add_parser(sub)
+    for name in names:
+        importlib.import_module(f"crest.cli.{name}_command").add_parser(sub)
     for command_parser in sub.choices.values():      # `crest run ... --debug` as well as `crest --debug run ...`
         add_debug_option(command_parser)
     return parser
@@ -61,8 +56,8 @@ def main(argv: list[str] | None = None) -> int:
     # manager) takes the same path with its own exit code.
     signal.signal(signal.SIGINT, signal.default_int_handler)
     signal.signal(signal.SIGTERM, _raise_terminated)
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    argv = sys.argv[1:] if argv is None else argv
+    args = build_parser(command_names(argv)).parse_args(argv)
     route_library_logging(args.debug)
     announce_compiles()
     try:

@@ -27,6 +27,7 @@ from crest.config import TestbedConfig
 from crest.driver import SafetyStop, Testbed
 from crest.session import Session
 from crest.view.live_state import SCREEN_PERIOD_S, LiveState
+from crest.view.no_view import NoView
 from crest.view.page import ESTOP_REASON, Page
 from crest.view.view_server import ViewServer
 
@@ -115,17 +116,6 @@ class LiveView:
         doc.add_root(page.layout)
         update()
         doc.add_periodic_callback(update, int(1000 * SCREEN_PERIOD_S))
-
-
-class NoView:
-    """Stands in for the live view when --view is not given: the same calls, nothing shown."""
-
-    def attach(self, session: Session) -> None:
-        """Nothing to follow."""
-
-    def follow(self, status: str, reference_mm: np.ndarray | None = None, total_cycles: int | None = None,
-               then: Callable[[int], None] | None = None) -> Callable[[int], None] | None:
-        return then
 
 
 @contextmanager
