@@ -32,8 +32,8 @@ def add_parser(sub) -> None:
     parser.add_argument("--catheter", default=None, help="starting catheter TOML (default configs/catheter.toml)")
     parser.add_argument("--workers", type=int, default=2, help="parallel candidate fits (default 2)")
     parser.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
-                        help="run the fits on the Dask cluster whose scheduler listens here (default: --workers "
-                             "local processes); the same result as the local run")
+                        help="run the fits on the Dask cluster whose scheduler listens here, instead of on "
+                             "--workers local processes; the result is the same")
     parser.add_argument("--blind-benchmark", action="store_true",
                         help="validate instead on virtual-testbed logs whose effect is withheld")
     parser.add_argument("--cases", type=int, default=40, help="blind benchmark: number of cases (default 40)")
