@@ -55,7 +55,7 @@ def cache_folder(seed: int, duration_s: float) -> Path:
 
 def draw_plant(prior: CatheterParams, rng: np.random.Generator) -> tuple[Plant, float, float]:
     """The plant, the tracker noise (mm per axis) and dropout fraction (see module doc)."""
-    factors = {name: 1.0 + rng.choice([-1.0, 1.0]) * rng.uniform(0.10, 0.20) for name in OFF_PRIOR}
+    factors = {name: 1.0 + float(rng.choice([-1.0, 1.0])) * float(rng.uniform(0.10, 0.20)) for name in OFF_PRIOR}
     params = prior.replace(**{name: getattr(prior, name) * factor for name, factor in factors.items()})
     zeros = tuple(float(v) for v in rng.normal(0.0, 0.002, 4))
     effect_id = str(rng.choice(catalog_ids(DAHL_EFFECT_RANGES)))
