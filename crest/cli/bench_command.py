@@ -30,6 +30,9 @@ def add_parser(sub) -> None:
                         help="duration of each control-loop run without and with the live view (default 20)")
     parser.add_argument("--gap-seed", type=int, default=0,
                         help="gap section: seed of the virtual-testbed plant (its log is recorded once and cached)")
+    parser.add_argument("--gap-cases", nargs="+", choices=GAP_CASES, default=list(GAP_CASES),
+                        help="gap section: only these logs (the synthetic one is recorded anew each time, about "
+                             "14 minutes)")
     parser.add_argument("--real-data", type=Path, default=None,
                         help="gap section: the continuum_nathan folder (default ../shared/data/continuum_nathan "
                              "beside the repository); the real-log case is skipped where it is absent")
@@ -52,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
         "rod_plant": lambda: plant_bench.rod_plant(),
         "full_stack": lambda: {f"{rate:.0f}_hz": stack_bench.full_stack(rate, args.stack_seconds)
                                for rate in (500.0, 250.0)},
-        "gap": lambda: diagnosis_benchmarks(args.gap_seed, args.real_data,
+        "gap": lambda: diagnosis_benchmarks(args.gap_seed, args.real_data, cases=args.gap_cases,
                                             progress=lambda message: print(f"crest bench: {message}",
                                                                            file=sys.stderr, flush=True)),
         "view": lambda: view_bench.control_loop_with_and_without_view(

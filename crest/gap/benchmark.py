@@ -116,14 +116,19 @@ def real_diagnosis(data_dir: Path | None = None, workers: int = 2) -> dict:
                        f"({logs.holdout_rows} rows)", "import_warnings": logs.import_warnings}
 
 
+CASES = ("synthetic", "virtual_testbed", "real")
+
+
 def diagnosis_benchmarks(seed: int = 0, data_dir: Path | None = None, workers: int = 2,
-                         progress: Callable[[str], None] | None = None) -> dict:
-    """The three cases of the module doc, one after the other."""
+                         progress: Callable[[str], None] | None = None, cases: Sequence[str] = CASES) -> dict:
+    """The cases of the module doc (all, or those named in `cases`), one after the other."""
     say = progress or (lambda message: None)
-    say("gap: synthetic log")
-    results = {"synthetic": synthetic_diagnosis(workers=workers, seed=seed)}
-    say("gap: virtual-testbed log")
-    results["virtual_testbed"] = testbed_diagnosis(seed, workers=workers, progress=say)
-    say("gap: real log")
-    results["real"] = real_diagnosis(data_dir, workers)
+    runs = {"synthetic": lambda: synthetic_diagnosis(workers=workers, seed=seed),
+            "virtual_testbed": lambda: testbed_diagnosis(seed, workers=workers, progress=say),
+            "real": lambda: real_diagnosis(data_dir, workers)}
+    results = {}
+    for case in CASES:
+        if case in cases:
+            say(f"gap: {case.replace('_', '-')} log")
+            results[case] = runs[case]()
     return results
