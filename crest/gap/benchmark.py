@@ -56,6 +56,7 @@ def timed_diagnosis(train: Path, holdout: Path, workers: int = 2) -> dict:
                 ModelFit.from_dict(result["baseline"]["fit"]), recordings["train"], recordings["holdout"],
                 settings.resolution),
             "verdict": result["verdict"]["effect"], "effects": result["verdict"]["effects"],
+            "top_candidates": [c["effect"] for c in result["candidates"][:3]], "rejected": result["verdict"]["rejected"],
             "shrink": result["verdict"]["shrink"], "baseline_holdout_rmse_mm": result["baseline"]["holdout_rmse_mm"],
             "sampling": result.get("sampling"), "resolution": result["settings"]["resolution"]}
 
