@@ -2,16 +2,19 @@
 
     crest gap TRAIN.csv [...] --holdout TEST.csv [...] --json OUT.json --report DIR
     crest gap --blind-benchmark --cases 40 --seed S --json OUT.json --report DIR
+    either with --scheduler tcp://HOST:PORT: the fits run on a Dask cluster (crest.gap.fit_executor)
 """
 from __future__ import annotations
 
 import argparse
 import json
 import sys
+from contextlib import nullcontext
 from pathlib import Path
 
 from crest.cli.common_options import check_output
 from crest.gap.blind_benchmark import run_blind_benchmark
+from crest.gap.fit_executor import check_scheduler_address, dask_executor, open_executor
 from crest.gap.log_diagnosis import diagnose_logs
 from crest.gap.log_recordings import load_recordings
 from crest.reports.blind_report import write_blind_report
@@ -28,6 +31,9 @@ def add_parser(sub) -> None:
     parser.add_argument("--report", type=Path, default=None, help="write the report (Markdown) and PNG figures here")
     parser.add_argument("--catheter", default=None, help="starting catheter TOML (default configs/catheter.toml)")
     parser.add_argument("--workers", type=int, default=2, help="parallel candidate fits (default 2)")
+    parser.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
+                        help="run the fits on the Dask cluster whose scheduler listens here, instead of on "
+                             "--workers local processes; the result is the same")
     parser.add_argument("--blind-benchmark", action="store_true",
                         help="validate instead on virtual-testbed logs whose effect is withheld")
     parser.add_argument("--cases", type=int, default=40, help="blind benchmark: number of cases (default 40)")
@@ -48,12 +54,19 @@ def run(args: argparse.Namespace) -> int:
     check_output(args.json_path)                                   # refused now, not after the diagnosis
     check_output(args.report, directory=True)
     check_output(args.work_dir, directory=True)
+    if args.scheduler is not None:
+        check_scheduler_address(args.scheduler)
     settings = DiagnosisSettings(workers=args.workers)
     if args.blind_benchmark:
         if args.train or args.holdout:
             raise ValueError("--blind-benchmark makes its own logs; do not pass training or held-out logs")
-        result = run_blind_benchmark(args.cases, args.seed, family=args.family, short=args.short, settings=settings,
-                                     work_dir=args.work_dir, progress=_progress)
+        # locally each case records and diagnoses in processes of its own; on a cluster its fits go there
+        with dask_executor(args.scheduler) if args.scheduler else nullcontext() as executor:
+            if args.scheduler:
+                _progress(f"fits run on the Dask cluster at {args.scheduler}")
+            result = run_blind_benchmark(args.cases, args.seed, family=args.family, short=args.short,
+                                         settings=settings, work_dir=args.work_dir, progress=_progress,
+                                         executor=executor)
         _write_json(result, args.json_path)
         if args.report:
             print(f"report written to {write_blind_report(result, args.report)}")
@@ -62,7 +75,11 @@ def run(args: argparse.Namespace) -> int:
     if not args.train or not args.holdout:
         raise ValueError("give training logs and --holdout logs (recorded on other trajectories), "
                          "e.g. `crest gap train.csv --holdout test.csv`")
-    result = diagnose_logs(args.train, args.holdout, args.catheter, settings, progress=_progress)
+    with open_executor(args.scheduler, args.workers) as executor:
+        if args.scheduler:
+            _progress(f"fits run on the Dask cluster at {args.scheduler}")
+        result = diagnose_logs(args.train, args.holdout, args.catheter, settings, progress=_progress,
+                               executor=executor)
     _write_json(result, args.json_path)
     if args.report:
         path = write_gap_report(result, load_recordings(args.holdout), args.report)

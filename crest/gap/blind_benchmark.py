@@ -41,9 +41,10 @@ from __future__ import annotations
 import json
 import math
 import tempfile
+import threading
 import time
 from collections.abc import Callable, Mapping
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Executor, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -229,10 +230,12 @@ def _redrawn(case: BlindCase, redraw: int, prior: CatheterParams) -> BlindCase:
 
 
 def record_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: ExcitationPlan,
-                prior: CatheterParams) -> tuple[BlindCase, Path, Path, Path | None]:
+                prior: CatheterParams, cancel: threading.Event | None = None
+                ) -> tuple[BlindCase, Path, Path, Path | None]:
     """Training and held-out logs of the case's plant on the virtual testbed, as `crest excite` records
-    them (in a process of its own, see `call_isolated`), and on the rod family with an effect a second
-    held-out log of the plant without it (None otherwise); a plant whose solver fails is redrawn."""
+    them (in a process of its own, see `call_isolated`; ended once `cancel` is set), and on the rod family
+    with an effect a second held-out log of the plant without it (None otherwise); a plant whose solver
+    fails is redrawn."""
     for redraw in range(MAX_REDRAWS + 1):
         if redraw:
             case = _redrawn(case, redraw, prior)
@@ -240,7 +243,7 @@ def record_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Exci
                                  realtime=False)
         try:
             results = call_isolated(_record, options, plan, folder / f"logs_{redraw}", prior,
-                                    timeout_s=RECORD_TIMEOUT_S)
+                                    timeout_s=RECORD_TIMEOUT_S, cancel=cancel)
         except (PlantFailure, CallTimedOut):
             continue
         if not all(r.tip_samples >= MIN_TIP_FRACTION_BEYOND_DROPOUT * (1.0 - case.tracker_dropout) * r.tracker_frames
@@ -253,7 +256,7 @@ def record_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Exci
             held_only = ExcitationPlan(plan.conditioning, {"holdout": plan.logs["holdout"]})
             try:
                 reference = call_isolated(_record, plain, held_only, folder / f"logs_{redraw}_plain", prior,
-                                          timeout_s=RECORD_TIMEOUT_S)["holdout"].log_path
+                                          timeout_s=RECORD_TIMEOUT_S, cancel=cancel)["holdout"].log_path
             except (PlantFailure, CallTimedOut):
                 continue
         return case, results["train"].log_path, results["holdout"].log_path, reference
@@ -325,17 +328,25 @@ def rod_effect_rms_mm(holdout: Path, reference: Path, noise_mm: float) -> float:
 
 
 def run_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: ExcitationPlan,
-             prior: CatheterParams, settings: DiagnosisSettings) -> dict:
-    """Record, diagnose blind, and compare with the truth. A plant that keeps failing is skipped (reported)."""
+             prior: CatheterParams, settings: DiagnosisSettings, executor: Executor | None = None,
+             cancel: threading.Event | None = None) -> dict:
+    """Record, diagnose blind, and compare with the truth. A plant that keeps failing is skipped (reported).
+
+    executor None: the diagnosis runs in a process of its own (`call_isolated`, with its own worker
+    processes and a time limit). Else its fits and the oracle's fit run on the executor (a Dask
+    cluster, `crest.gap.fit_executor`) and the rest of it here; the numbers are the same.
+    cancel: once set, the recording or diagnosis running in a process of its own is ended (CallCancelled).
+    """
     start = time.perf_counter()
     head = {"case": case.index, "family": case.family, "kind": case.kind, "truth": list(case.effects)}
     try:
-        case, train, holdout, reference = record_case(case, folder, config, plan, prior)
+        case, train, holdout, reference = record_case(case, folder, config, plan, prior, cancel)
     except PlantFailure as error:
         return {**head, "skipped": str(error)}
     recorded = time.perf_counter()
     try:
-        result = call_isolated(diagnose_logs, [train], [holdout], settings=settings, timeout_s=DIAGNOSIS_TIMEOUT_S)
+        result = call_isolated(diagnose_logs, [train], [holdout], settings=settings, timeout_s=DIAGNOSIS_TIMEOUT_S,
+                               cancel=cancel) if executor is None else diagnose_logs([train], [holdout], settings=settings, executor=executor)
     except CallTimedOut as error:
         return {**head, "redraws": case.redraws, "record_seconds": recorded - start, "no_result": str(error)}
     seconds = time.perf_counter() - recorded
@@ -353,13 +364,16 @@ def run_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Excitat
            "record_seconds": recorded - start, "seconds": seconds, "timing_s": result["timing_s"],
            "slowest_candidate": max(result["candidates"], key=lambda c: c["seconds"])["effect"]}
     if case.family == "dahl" and case.effects:
-        oracle, exact, effect_rms_mm = oracle_shrinks(case, train, holdout, prior, verdict["holdout_rmse_before_mm"],
-                                                      settings)
+        oracle_args = (case, train, holdout, prior, verdict["holdout_rmse_before_mm"], settings)
+        oracle, exact, effect_rms_mm = oracle_shrinks(*oracle_args) if executor is None else \
+            executor.submit(oracle_shrinks, *oracle_args).result()
         row.update(oracle_shrink=oracle, exact_truth_shrink=exact)
     elif case.family == "rod" and case.effects:
         effect_rms_mm = rod_effect_rms_mm(holdout, reference, case.tracker_noise_mm)
         if case.kind == "single":
-            row["oracle_shrink"] = rod_oracle_shrink(case.effects[0], result, train, holdout, prior, settings)
+            oracle_args = (case.effects[0], result, train, holdout, prior, settings)
+            row["oracle_shrink"] = rod_oracle_shrink(*oracle_args) if executor is None else \
+                executor.submit(rod_oracle_shrink, *oracle_args).result()
     else:
         effect_rms_mm = 0.0
     relative = effect_rms_mm / row["baseline_holdout_rmse_mm"] if row["baseline_holdout_rmse_mm"] > 0 else 0.0
@@ -441,12 +455,14 @@ def score(all_rows: list[dict]) -> dict:
 
 def run_blind_benchmark(cases: int = 40, seed: int = 0, *, family: str = "dahl", short: bool = False,
                         settings: DiagnosisSettings = DiagnosisSettings(), work_dir: Path | str | None = None,
-                        parallel_cases: int = PARALLEL_CASES, progress: Callable[[str], None] | None = None) -> dict:
+                        parallel_cases: int = PARALLEL_CASES, progress: Callable[[str], None] | None = None,
+                        executor: Executor | None = None) -> dict:
     """Draw, record, diagnose and score `cases` blind cases per family ("dahl", "rod" or "both");
     returns {"score": {family: score}, "cases", "settings"}.
 
     work_dir keeps each case's plant description and logs (default: a temporary folder).
     parallel_cases: cases run at once (each records and diagnoses in processes of its own).
+    executor: where the cases' fits run (see `run_case`); the scores do not depend on it.
     """
     families = list(FAMILIES) if family == "both" else [family]
     for name in families:
@@ -462,9 +478,13 @@ def run_blind_benchmark(cases: int = 40, seed: int = 0, *, family: str = "dahl",
         root = Path(work_dir) if work_dir else Path(scratch)
 
         def run(case: BlindCase) -> dict:
-            return run_case(case, root / f"{case.family}_case_{case.index:03d}", config, plan, prior, settings)
+            return run_case(case, root / f"{case.family}_case_{case.index:03d}", config, plan, prior, settings,
+                            executor, cancel)
 
-        with ThreadPoolExecutor(parallel_cases) as pool:
+        cancel = threading.Event()
+
+        pool = ThreadPoolExecutor(parallel_cases)
+        try:
             for row in pool.map(run, drawn):
                 rows.append(row)
                 elapsed = time.perf_counter() - clock
@@ -479,6 +499,11 @@ def run_blind_benchmark(cases: int = 40, seed: int = 0, *, family: str = "dahl",
                 say(f"{head}: truth {'+'.join(row['truth']) or 'none'}, verdict "
                     f"{'+'.join(row['predicted_effects']) or row['predicted']}, shrink {row['predicted_shrink']:.2f}"
                     f"{oracle}, recorded in {row['record_seconds']:.0f} s, diagnosed in {row['seconds']:.0f} s")
+        finally:
+            # On Ctrl-C no further case starts, and the running ones' recordings and local diagnoses are
+            # ended; their fits on an executor end when the caller, once this returns, cancels them.
+            cancel.set()
+            pool.shutdown(wait=executor is None, cancel_futures=True)
     total = time.perf_counter() - clock
     return {"score": {name: score([r for r in rows if r["family"] == name]) for name in families}, "cases": rows,
             "settings": {"cases": cases, "seed": seed, "families": families,

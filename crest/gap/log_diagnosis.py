@@ -6,7 +6,7 @@ hidden effect) is not an input.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import Executor, ProcessPoolExecutor
 from contextlib import nullcontext
 from pathlib import Path
 
@@ -46,7 +46,8 @@ def calibrate_logs(train: Sequence[Path | str], catheter_toml: Path | str | None
 
 def diagnose_logs(train: Sequence[Path | str], holdout: Sequence[Path | str],
                   catheter_toml: Path | str | None = None, settings: DiagnosisSettings = DiagnosisSettings(),
-                  progress: Callable[[str], None] | None = None) -> dict:
-    """The gap diagnosis (model.gap.diagnosis.diagnose) of training and held-out logs."""
+                  progress: Callable[[str], None] | None = None, executor: Executor | None = None) -> dict:
+    """The gap diagnosis (model.gap.diagnosis.diagnose) of training and held-out logs; executor: where
+    the fits run (default: local processes, see `crest.gap.fit_executor`)."""
     return diagnose(load_recordings(train), load_recordings(holdout), prior_catheter(catheter_toml), settings,
-                    progress)
+                    progress, executor)

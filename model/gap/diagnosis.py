@@ -60,8 +60,12 @@ class DiagnosisSettings:
 
 def diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: CatheterParams,
              settings: DiagnosisSettings = DiagnosisSettings(),
-             progress: Callable[[str], None] | None = None) -> dict:
+             progress: Callable[[str], None] | None = None, executor: Executor | None = None) -> dict:
     """Diagnose the gap between the model (starting from `prior`) and the recordings.
+
+    executor: runs the independent fits (the baseline's starts, the candidates, the pairs); the
+    results are taken in submission order, so they do not depend on the executor. Default: a
+    process pool of `settings.workers` made here (none for one worker).
 
     Returns {"format", "baseline", "where", "concentrated", "signatures", "candidates", "pairs",
     "verdict", "settings", "timing_s"}; "verdict" holds "effect" (best id or "none"), "effects"
@@ -70,6 +74,8 @@ def diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: Ca
     if not train or not holdout:
         raise RecordingError("the diagnosis needs at least one training and one held-out recording")
     say = progress or (lambda message: None)
+    if executor is not None:
+        return _diagnose(train, holdout, prior, settings, say, executor)
     with ProcessPoolExecutor(settings.workers) if settings.workers > 1 else nullcontext() as pool:
         return _diagnose(train, holdout, prior, settings, say, pool)
 

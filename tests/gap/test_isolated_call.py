@@ -2,11 +2,12 @@
 return in time, or is interrupted by Ctrl-C, is ended with its whole process group."""
 import os
 import signal
+import threading
 import time
 
 import pytest
 
-from crest.gap.isolated_call import CallTimedOut, call_isolated
+from crest.gap.isolated_call import CallCancelled, CallTimedOut, call_isolated
 
 
 def child_pid_then_sleep(path, seconds):
@@ -53,4 +54,27 @@ def test_ctrl_c_while_waiting_kills_the_call(tmp_path):
         signal.setitimer(signal.ITIMER_REAL, 0.0)
         signal.signal(signal.SIGALRM, previous)
     assert time.monotonic() - start < 10.0
+    assert_ended(tmp_path / "pid")
+
+
+def test_a_call_waited_for_in_a_thread_is_killed_when_cancelled(tmp_path):
+    """Ctrl-C reaches only the main thread: it ends a call another thread waits for through its event."""
+    cancel = threading.Event()
+    outcome = []
+
+    def wait_in_thread():
+        try:
+            call_isolated(child_pid_then_sleep, tmp_path / "pid", 60.0, timeout_s=60.0, cancel=cancel)
+        except CallCancelled as error:
+            outcome.append(error)
+
+    waiter = threading.Thread(target=wait_in_thread)
+    waiter.start()
+    deadline = time.monotonic() + 60.0
+    while not (tmp_path / "pid").exists() or not (tmp_path / "pid").read_text():
+        assert time.monotonic() < deadline, "the child never started"
+        time.sleep(0.05)
+    cancel.set()
+    waiter.join(timeout=30.0)
+    assert not waiter.is_alive() and len(outcome) == 1
     assert_ended(tmp_path / "pid")
