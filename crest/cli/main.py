@@ -6,12 +6,12 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import signal
 import sys
 
 from crest.cli.common_options import add_debug_option
 from crest.cli.compile_notice import announce_compiles
 from crest.cli.library_logging import route_library_logging
+from crest.cli.stop_signals import install_stop_signals
 from crest.config import ConfigError
 from crest.driver import SafetyStop, Terminated
 from crest.exit_codes import ExitCode
@@ -42,20 +42,8 @@ def build_parser(names: tuple[str, ...] = COMMANDS) -> argparse.ArgumentParser:
     return parser
 
 
-def _raise_terminated(signum, frame) -> None:
-    """SIGTERM: stop like Ctrl-C. Later SIGTERMs are ignored, so a supervisor that repeats the
-    signal cannot break off the stop the first one started (SIGKILL still ends the process)."""
-    signal.signal(signal.SIGTERM, signal.SIG_IGN)
-    raise Terminated()
-
-
 def main(argv: list[str] | None = None) -> int:
-    # A shell starts background commands with SIGINT ignored, and Python then never raises
-    # KeyboardInterrupt. An interrupt (Ctrl-C, or `kill -INT` from a supervisor) must still stop
-    # every axis and save the log, however crest was started. SIGTERM (`kill PID`, a service
-    # manager) takes the same path with its own exit code.
-    signal.signal(signal.SIGINT, signal.default_int_handler)
-    signal.signal(signal.SIGTERM, _raise_terminated)
+    install_stop_signals()          # Ctrl-C and SIGTERM stop the command, however it was started
     argv = sys.argv[1:] if argv is None else argv
     args = build_parser(command_names(argv)).parse_args(argv)
     route_library_logging(args.debug)

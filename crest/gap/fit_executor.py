@@ -6,7 +6,7 @@ collects the results in the order it submitted them, and the fits draw no random
 result does not depend on which worker ran which fit or when it finished: a fixed seed gives the
 same diagnosis locally and on a cluster.
 
-`open_executor(None, workers)`: a local ProcessPoolExecutor (none for one worker).
+`open_executor(None, workers)`: a local ProcessPoolExecutor (none for one worker), see `local_executor`.
 `open_executor("tcp://HOST:PORT")`: the executor of a `distributed.Client` connected to a running
 Dask scheduler (`Client.get_executor`; the scheduler and its workers are started with `dask
 scheduler` and `dask worker`, and the workers must be able to import this project). The address is
@@ -17,10 +17,11 @@ sees an Executor.
 """
 from __future__ import annotations
 
+import multiprocessing
 import re
 from collections.abc import Iterator
 from concurrent.futures import Executor, ProcessPoolExecutor
-from contextlib import contextmanager, nullcontext
+from contextlib import contextmanager
 
 CONNECT_TIMEOUT_S = 10.0
 ADDRESS = re.compile(r"tcp://(?P<host>[A-Za-z0-9.\-]+):(?P<port>[0-9]{1,5})")
@@ -44,11 +45,30 @@ def open_executor(scheduler: str | None = None, workers: int = 2) -> Iterator[Ex
     """The executor for the fits (see module doc): `workers` local processes, or the Dask cluster
     whose scheduler listens at `scheduler`."""
     if scheduler is None:
-        with ProcessPoolExecutor(workers) if workers > 1 else nullcontext() as pool:
+        with local_executor(workers) as pool:
             yield pool
         return
     with dask_executor(scheduler) as executor:
         yield executor
+
+
+@contextmanager
+def local_executor(workers: int) -> Iterator[Executor | None]:
+    """`workers` local processes (None for one). Left by an exception (Ctrl-C, SIGTERM, an error), the
+    fits not started are cancelled and the running ones' processes terminated at once: a pool's own
+    exit would wait for them, minutes on a long log."""
+    if workers <= 1:
+        yield None
+        return
+    pool = ProcessPoolExecutor(workers)
+    try:
+        yield pool
+    except BaseException:
+        pool.shutdown(wait=False, cancel_futures=True)
+        for process in multiprocessing.active_children():
+            process.terminate()
+        raise
+    pool.shutdown()
 
 
 @contextmanager

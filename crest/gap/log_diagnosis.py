@@ -6,10 +6,10 @@ hidden effect) is not an input.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from concurrent.futures import Executor, ProcessPoolExecutor
-from contextlib import nullcontext
+from concurrent.futures import Executor
 from pathlib import Path
 
+from crest.gap.fit_executor import local_executor
 from crest.gap.log_recordings import load_recordings
 from model import CatheterParams
 from model.gap.calibration import FAST_TENDON_SPEED_MM_S, ModelFit, calibrate_base, fast_travel_share, is_fast
@@ -37,7 +37,7 @@ def calibrate_logs(train: Sequence[Path | str], catheter_toml: Path | str | None
         say(f"{100 * fast_travel_share(recordings):.0f}% of the tendon travel at >= "
             f"{FAST_TENDON_SPEED_MM_S:g} mm/s: "
             + ("fast, fitting the damping time and inertia scale too" if fit_dynamics else "quasi-static fit"))
-    with ProcessPoolExecutor(settings.workers) if settings.workers > 1 else nullcontext() as pool:
+    with local_executor(settings.workers) as pool:
         return calibrate_base(recordings, prior, resolution=settings.resolution,
                               max_iterations=settings.baseline_iterations, executor=pool,
                               on_fit=lambda done, total: say(f"base model: {done}/{total} starts fitted"),

@@ -5,6 +5,7 @@ read back from what the run leaves behind: exit code, its one line, the log, the
 cause and the CAN recording beside the log.
 """
 import json
+import os
 import signal
 import struct
 import subprocess
@@ -136,3 +137,24 @@ def test_a_drive_that_stops_answering_sdo_ends_in_an_sdo_safety_stop_with_its_ca
     assert "tendon2" in sidecar["summary"]["stop_cause"] and "SDO" in sidecar["summary"]["stop_cause"]
     assert sidecar["summary"]["exit_code"] == ExitCode.SDO_FAILURE
     assert len(read_log(log_path)) == sidecar["summary"]["samples"] > 50
+
+
+def test_sigterm_to_a_fit_and_its_workers_ends_it_with_one_line_and_no_traceback(tmp_path):
+    """`crest fit` runs its starts on a process pool. A service manager's stop signals the whole
+    process group: the workers end quietly, the command says it was stopped, and nothing is written."""
+    log = tmp_path / "sweep.csv"
+    recorded = crest("run", "builtin:sweep", "--fast", "--record", str(log))
+    assert recorded.returncode == 0, recorded.stderr
+    process = start_crest("fit", str(log), "--out", str(tmp_path / "fitted.toml"), stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, text=True, start_new_session=True)
+    lines = []
+    while not any("tendon travel" in line for line in lines):    # the fits start after this line
+        line = process.stderr.readline()
+        assert line, process.communicate()
+        lines.append(line)
+    time.sleep(2.0)                                              # the pool's workers are at work
+    os.killpg(process.pid, signal.SIGTERM)
+    stdout, stderr = process.communicate(timeout=120)
+    assert process.returncode == ExitCode.TERMINATED, stderr
+    assert "Traceback" not in stderr and crest_lines(stderr)[-1] == "crest: stopped by SIGTERM"
+    assert not (tmp_path / "fitted.toml").exists()
