@@ -138,6 +138,13 @@ def predict_tips(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: 
     return _run(params, effects, zero_offsets_mm, recording, resolution, iteration_limit)[0]
 
 
+def predict_tips_and_work(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray,
+                          recording: Recording, resolution: Resolution,
+                          iteration_limit: int | None = None) -> tuple[np.ndarray, int]:
+    """`predict_tips` and the Newton iterations the run took (the unit of its limit)."""
+    return _run(params, effects, zero_offsets_mm, recording, resolution, iteration_limit)
+
+
 def solver_work(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray,
                 recordings: Sequence[Recording], resolution: Resolution) -> int:
     """Newton iterations of the model's runs along the recordings (the unit of `predict_tips`' limit)."""
