@@ -154,16 +154,15 @@ def tip_errors(fit: ModelFit, recordings: Sequence[Recording], resolution: Resol
     budget = math.inf if iteration_limit is None else iteration_limit
     errors = []
     for r in recordings:
-        try:
-            if budget < 0:
-                raise SolverBudgetExceeded("the runs along the earlier recordings used up the iteration limit")
-            tips, work = predict_tips_and_work(fit.params, terms, zero, r, resolution, budget)
-            budget -= work
-        except SolverBudgetExceeded:
-            budget = -1
-            tips = np.full(r.tip_mm.shape, np.inf)
-        except ModelSolverError:     # diverged
-            tips = np.full(r.tip_mm.shape, np.inf)
+        tips = np.full(r.tip_mm.shape, np.inf)      # unless the run ends within the limit left
+        if budget >= 0:
+            try:
+                tips, work = predict_tips_and_work(fit.params, terms, zero, r, resolution, budget)
+                budget -= work
+            except SolverBudgetExceeded:
+                budget = -1.0
+            except ModelSolverError:     # diverged: infinite errors on this recording only
+                pass
         error = (tips - r.tip_mm)[r.valid]
         error[~np.isfinite(error)] = np.inf
         errors.append(error)
