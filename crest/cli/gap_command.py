@@ -18,7 +18,7 @@ from crest.gap.fit_executor import check_scheduler_address, dask_executor, open_
 from crest.gap.log_diagnosis import diagnose_logs
 from crest.gap.log_recordings import load_recordings
 from crest.reports.blind_report import write_blind_report
-from crest.reports.gap_report import write_gap_report
+from crest.reports.gap_report import sampling_lines, write_gap_report
 from model.gap.diagnosis import DiagnosisSettings
 from model.gap.finite_json import finite_tree
 
@@ -114,7 +114,7 @@ def format_verdict(result: dict) -> str:
         lines.append(f"residual above the noise floor (model form): {verdict['model_form_rms_mm']:.3f} mm RMS")
     for row in verdict["rejected"]:
         lines.append(f"not {row['effect']}: " + "; ".join(row["reasons"]))
-    return "\n".join(lines + [f"  {line}" for line in verdict["residual"]])
+    return "\n".join(lines + [f"  {line}" for line in verdict["residual"]] + sampling_lines(result["sampling"]))
 
 
 def format_score(score: dict) -> str:

@@ -103,6 +103,7 @@ def markdown(result: dict) -> str:
     lines = ["# Sim-to-real gap report", "",
              f"Training: {', '.join(result['settings']['train'])}  ",
              f"Held out: {', '.join(result['settings']['holdout'])}", "",
+             "Sampling:", ""] + [f"- {line}" for line in sampling_lines(result["sampling"])] + ["",
              "## Verdict", "",
              f"- effect: **{verdict['effect']}**" + (f" (selected: {', '.join(verdict['effects'])})"
                                                     if len(verdict["effects"]) > 1 else ""),
@@ -160,6 +161,26 @@ def markdown(result: dict) -> str:
               "Strong correlations: " + ("; ".join(f"{c['a']} / {c['b']}: {c['correlation']:+.2f}"
                                                    for c in fit["strong_correlations"]) or "none"), ""]
     return "\n".join(lines)
+
+
+def sampling_lines(sampling: dict) -> list[str]:
+    """What of the logs the fits and the held-out error used (the diagnosis' "sampling" block), one line each."""
+    def part(rows: list[dict], capped: bool) -> str:
+        return "; ".join(f"{row['recording']}: {row['rows_used']} of {row['rows']} rows"
+                         + (f" (one in {row['decimation']})" if row["decimation"] > 1 else "")
+                         + (f", the first {row['duration_used_s']:.0f} s of {row['duration_s']:.0f} s" if capped else "")
+                         for row in rows)
+
+    fit = (f"fits use {sampling['train_rows_used']} of {sampling['train_rows']} training rows"
+           + (f", decimated to about {sampling['fit_rate_hz']:g} Hz" if any(r["decimation"] > 1 for r in
+                                                                           sampling["train"]) else "")
+           + (f" and cut to {sampling['max_fit_samples']} rows in total (max_fit_samples)" if sampling["capped"]
+              else "") + f": {part(sampling['train'], sampling['capped'])}")
+    held = (f"held-out error on {sampling['holdout_rows_used']} of {sampling['holdout_rows']} rows"
+            + (f", decimated to about {sampling['fit_rate_hz']:g} Hz" if any(r["decimation"] > 1 for r in
+                                                                            sampling["holdout"]) else "")
+            + f": {part(sampling['holdout'], False)}")
+    return [fit, held]
 
 
 def _signature_lines(signature: dict) -> list[str]:

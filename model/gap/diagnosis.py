@@ -68,8 +68,10 @@ def diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: Ca
     process pool of `settings.workers` made here (none for one worker).
 
     Returns {"format", "baseline", "where", "concentrated", "signatures", "candidates", "pairs",
-    "verdict", "settings", "timing_s"}; "verdict" holds "effect" (best id or "none"), "effects"
-    (all selected), "holdout_rmse_before_mm", "holdout_rmse_after_mm" and "shrink" (0..1).
+    "verdict", "settings", "sampling", "timing_s"}; "verdict" holds "effect" (best id or "none"),
+    "effects" (all selected), "holdout_rmse_before_mm", "holdout_rmse_after_mm" and "shrink" (0..1);
+    "sampling" says which rows of the logs the fits and the held-out evaluation used
+    (`Resolution.sampling`: decimation, the training cap).
     """
     if not train or not holdout:
         raise RecordingError("the diagnosis needs at least one training and one held-out recording")
@@ -230,6 +232,7 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
         "settings": {**asdict(settings), "train": [r.name for r in train], "holdout": [r.name for r in holdout],
                      "geometry": {"tendon_offset_mm": baseline.params.tendon_offset_mm,
                                   "flexible_length_mm": train[0].flexible_length_mm}},
+        "sampling": res.sampling(train, holdout),
         "timing_s": timing,
     }
     result, nulls = finite_tree(result)

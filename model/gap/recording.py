@@ -5,6 +5,8 @@ free length), because the model is driven by what the drives did, not by what th
 """
 from __future__ import annotations
 
+import functools
+import hashlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -64,6 +66,14 @@ class Recording:
     def sample_period_s(self) -> float:
         """Median time between samples."""
         return float(np.median(np.diff(self.t_s)))
+
+    @functools.cached_property
+    def input_digest(self) -> bytes:
+        """A digest of what drives the model (times, tendon and insertion positions): equal inputs, equal runs."""
+        digest = hashlib.blake2b(digest_size=16)
+        for array in (self.t_s, self.tendon_mm, self.insertion_mm):
+            digest.update(np.ascontiguousarray(array, dtype=float).tobytes())
+        return digest.digest()
 
     def decimated(self, factor: int) -> "Recording":
         """About every `factor`-th sample: from each block of `factor` samples the first one with a tip

@@ -7,12 +7,13 @@ straight, unloaded state at its first free length.
 from __future__ import annotations
 
 import math
+from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from model.dahl_catheter import DahlCatheter
+from model.dahl_catheter import DahlCatheter, ModelSolverError, SolverBudgetExceeded
 from model.effect_terms import EffectTerms
 from model.gap.free_parameters import TENDON_OFFSET_FIT_SPAN
 from model.gap.recording import Recording, RecordingError
@@ -43,7 +44,7 @@ class Resolution:
         recording cut to its first part in proportion: a run costs about 10 us per sample and
         sub-step, and the standard training excitation (about 230 s, 2300 samples) holds every
         primitive, so a longer log repeats what the fit has already seen. Held-out recordings
-        are evaluated in full.
+        are decimated like the training ones but never cut. `sampling` says what a diagnosis used.
     """
 
     n_elements: int = 8
@@ -68,6 +69,34 @@ class Resolution:
         if total <= self.max_fit_samples:
             return decimated
         return [r.head(max(3, self.max_fit_samples * len(r) // total)) for r in decimated]
+
+    def sampling(self, train: Sequence[Recording], holdout: Sequence[Recording]) -> dict:
+        """What of the logs the diagnosis uses: per recording, its rows (and rows with a tip), the
+        decimation factor, and the rows the fits use (training, after decimation and the
+        `max_fit_samples` cap) or the held-out evaluation uses (decimated, never capped); with the
+        time span used and whether the fits saw only the head of the training logs (`capped`).
+
+        A decimated row stands for its block of `decimation` rows (`Recording.decimated`); the rows
+        between are not compared, so the held-out error is the error on every `decimation`-th row.
+        """
+        def rows(recording: Recording, used: Recording, decimation: int) -> dict:
+            return {"recording": recording.name, "rows": len(recording), "rows_with_tip": int(recording.valid.sum()),
+                    "decimation": decimation, "rows_used": len(used), "rows_used_with_tip": int(used.valid.sum()),
+                    "duration_s": float(recording.t_s[-1] - recording.t_s[0]),
+                    "duration_used_s": float(used.t_s[-1] - used.t_s[0])}
+
+        fitted = self.prepare_training(train)
+        train_rows = [rows(r, used, self.decimation(r)) for r, used in zip(train, fitted)]
+        holdout_rows = [rows(r, used, self.decimation(r)) for r, used in zip(holdout, self.prepare(holdout))]
+        decimated_rows = sum(len(r) for r in self.prepare(train))
+        return {"fit_rate_hz": self.fit_rate_hz, "max_fit_samples": self.max_fit_samples,
+                "capped": decimated_rows > self.max_fit_samples,
+                "decimated": any(row["decimation"] > 1 for row in train_rows + holdout_rows),
+                "train_rows": sum(row["rows"] for row in train_rows),
+                "train_rows_used": sum(row["rows_used"] for row in train_rows),
+                "holdout_rows": sum(row["rows"] for row in holdout_rows),
+                "holdout_rows_used": sum(row["rows_used"] for row in holdout_rows),
+                "train": train_rows, "holdout": holdout_rows}
 
 
 def catheter_for(base: CatheterParams, recordings: Sequence[Recording]) -> CatheterParams:
@@ -113,6 +142,13 @@ def predict_tips(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: 
     return _run(params, effects, zero_offsets_mm, recording, resolution, iteration_limit)[0]
 
 
+def predict_tips_and_work(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray,
+                          recording: Recording, resolution: Resolution,
+                          iteration_limit: int | None = None) -> tuple[np.ndarray, int]:
+    """`predict_tips` and the Newton iterations the run took (the unit of its limit)."""
+    return _run(params, effects, zero_offsets_mm, recording, resolution, iteration_limit)
+
+
 def solver_work(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray,
                 recordings: Sequence[Recording], resolution: Resolution) -> int:
     """Newton iterations of the model's runs along the recordings (the unit of `predict_tips`' limit)."""
@@ -121,11 +157,65 @@ def solver_work(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: n
 
 def _run(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray, recording: Recording,
          resolution: Resolution, iteration_limit: int | None = None) -> tuple[np.ndarray, int]:
-    """Tips [T, 3] and the Newton iterations they took (see `predict_tips`)."""
+    """Tips [T, 3] and the Newton iterations they took (see `predict_tips`).
+
+    The last RUN_MEMORY runs of this process are remembered by their exact inputs (parameters and
+    effects by repr, which tells -0.0 from 0.0; zero offsets and the recording's inputs by their
+    bytes). A fit asks for the same run again where it continues from a point it has fitted before:
+    a restart or a final fit re-evaluates the cost and the finite-difference Jacobian at the point
+    the previous least-squares run ended on, and every fit first measures the solver work of its
+    start (`calibration.iteration_limit`) and then evaluates the cost there. The model is
+    deterministic, so a remembered run is the run: it fails again where its Newton iterations exceed
+    the limit now asked for. A run given up at a limit fails under any limit up to that one and
+    runs again under a higher one; a diverged run diverges again (both are ModelSolverErrors, which
+    the fits score alike).
+    """
+    key = (repr(params), repr(effects), np.asarray(zero_offsets_mm, dtype=float).tobytes(), recording.input_digest,
+           resolution)
+    limit = math.inf if iteration_limit is None else iteration_limit
+    known = _RUNS.get(key)
+    if known is not None:
+        _RUNS.move_to_end(key)
+        if known.diverged:
+            raise ModelSolverError(f"the catheter model diverged (non-finite state) with {params}")
+        if known.tips is not None and known.iterations <= limit:
+            return known.tips.copy(), known.iterations
+        if known.tips is not None or limit <= known.iterations:
+            raise SolverBudgetExceeded(f"the model run takes over {limit:g} solver iterations, its budget")
     model = _model(params, effects, recording, resolution)
-    tips = model.run(recording.tendon_mm - zero_offsets_mm, recording.insertion_mm, recording.sample_period_s,
-                     math.inf if iteration_limit is None else iteration_limit)
+    try:
+        tips = model.run(recording.tendon_mm - zero_offsets_mm, recording.insertion_mm, recording.sample_period_s,
+                         limit)
+    except SolverBudgetExceeded:
+        _remember(key, _Outcome(None, limit, False))
+        raise
+    except ModelSolverError:
+        _remember(key, _Outcome(None, 0, True))
+        raise
+    _remember(key, _Outcome(tips.copy(), model.solver_iterations[0], False))
     return tips, model.solver_iterations[0]
+
+
+RUN_MEMORY = 96   # runs remembered per process: a Jacobian and its point take 1 + n runs per recording
+
+
+@dataclass(frozen=True)
+class _Outcome:
+    """A remembered run: its tips and Newton iterations; or no tips, over a budget of `iterations`; or diverged."""
+
+    tips: np.ndarray | None
+    iterations: float
+    diverged: bool
+
+
+_RUNS: OrderedDict[tuple, _Outcome] = OrderedDict()
+
+
+def _remember(key: tuple, outcome: _Outcome) -> None:
+    _RUNS[key] = outcome
+    _RUNS.move_to_end(key)
+    while len(_RUNS) > RUN_MEMORY:
+        _RUNS.popitem(last=False)
 
 
 def predict_tips_and_tension(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray,

@@ -1,0 +1,52 @@
+"""A fit gives up on parameters where the solver crawls by counting Newton iterations (issue 17): the
+limit bounds the runs along all the recordings together, not each recording's run, and a remembered
+run obeys the limit it is asked for like a fresh one."""
+import math
+
+import numpy as np
+import pytest
+
+from model import CatheterParams, SolverBudgetExceeded
+from model.gap.calibration import ModelFit, tip_errors
+from model.gap.recording import Recording
+from model.gap.simulation import Resolution, catheter_for, predict_tips_and_work
+
+RESOLUTION = Resolution(n_elements=6)
+
+
+def bending_recording(name: str, turns: float) -> Recording:
+    """A 10 Hz log of tendon 1 and 3 pulled antagonistically back and forth (4 mm amplitude)."""
+    t_s = np.arange(0.0, 20.0 * turns, 0.1)
+    pull_mm = 4.0 * np.sin(2 * math.pi * t_s / 20.0)
+    tendon_mm = np.column_stack([pull_mm, np.zeros_like(t_s), -pull_mm, np.zeros_like(t_s)])
+    return Recording(name, t_s, tendon_mm, np.full(len(t_s), 80.0), np.zeros((len(t_s), 3)), None,
+                     flexible_length_mm=80.0, tendon_offset_mm=1.0, outer_diameter_mm=None)
+
+
+@pytest.fixture(scope="module")
+def case():
+    recordings = [bending_recording("first", 1.0), bending_recording("second", 1.5)]
+    fit = ModelFit(catheter_for(CatheterParams.from_toml(), recordings), (0.0, 0.0, 0.0, 0.0), {})
+    work = [predict_tips_and_work(fit.params, fit.terms(), np.zeros(4), r, RESOLUTION)[1] for r in recordings]
+    return recordings, fit, work
+
+
+def test_the_limit_bounds_the_runs_along_all_recordings_together(case):
+    recordings, fit, (first, second) = case
+    enough = tip_errors(fit, recordings, RESOLUTION, first + second)
+    assert all(np.isfinite(e).all() for e in enough)
+    # each run alone is under this limit, both together are over it
+    limit = max(first, second) + min(first, second) // 2
+    assert first <= limit and second <= limit < first + second
+    errors = tip_errors(fit, recordings, RESOLUTION, limit)
+    assert np.isfinite(errors[0]).all() and np.isinf(errors[1]).all()
+
+
+def test_a_remembered_run_obeys_the_limit_asked_for(case):
+    recordings, fit, (first, _) = case
+    tips, work = predict_tips_and_work(fit.params, fit.terms(), np.zeros(4), recordings[0], RESOLUTION)
+    assert work == first
+    with pytest.raises(SolverBudgetExceeded):
+        predict_tips_and_work(fit.params, fit.terms(), np.zeros(4), recordings[0], RESOLUTION, first - 1)
+    again, work_again = predict_tips_and_work(fit.params, fit.terms(), np.zeros(4), recordings[0], RESOLUTION, first)
+    assert work_again == first and np.array_equal(again, tips)
