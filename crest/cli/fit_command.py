@@ -13,6 +13,7 @@ from crest.gap.log_diagnosis import calibrate_logs, prior_catheter
 from crest.gap.log_recordings import load_recordings
 from model.gap.calibration import rmse_mm, tip_errors
 from model.gap.diagnosis import DiagnosisSettings
+from model.gap.recording import RecordingError
 
 FITTED = ("bending_stiffness_nmm2", "axial_stiffness_n", "mu", "sigma_n_per_mm2", "fsc_n_per_mm",
           "damping_time_s", "inertia_scale")
@@ -44,7 +45,8 @@ def run(args: argparse.Namespace) -> int:
                          fit_dynamics=DYNAMICS_CHOICES[args.dynamics])
     holdout_rmse_mm = rmse_mm(tip_errors(fit, settings.resolution.prepare(held), settings.resolution)) if held else None
     if holdout_rmse_mm is not None and not math.isfinite(holdout_rmse_mm):
-        raise SystemExit("crest fit: the fitted model diverges on the held-out logs; are they of the same catheter?")
+        raise RecordingError("the fitted model diverges on the held-out logs; check that they come from the same "
+                             "catheter as the training logs")
     prior = prior_catheter(args.catheter)
     fitted = prior.replace(tendon_offset_mm=fit.params.tendon_offset_mm,
                            outer_diameter_mm=fit.params.outer_diameter_mm,
