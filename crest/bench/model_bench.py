@@ -17,8 +17,12 @@ def articulation_path(params: CatheterParams, duration_s: float = 10.0, peak_deg
     return np.array([tendons_from_articulation(t, 0.0, params.tendon_offset_mm, 0.02) for t in theta])
 
 
-def time_run_s(params: CatheterParams, n_elements: int, path: np.ndarray, repeats: int = 3) -> float:
-    """Best wall time of `run` over the path (after one warm-up that also compiles)."""
+def time_run_s(params: CatheterParams, n_elements: int, path: np.ndarray, repeats: int = 15) -> float:
+    """Best wall time of `run` over the path (after one warm-up that also compiles).
+
+    The best of many short runs (a 10 s path takes about 10 ms) is the model's own cost: on a
+    shared machine single runs vary by 10% with the neighbours' load, and the best of 3 by 4%.
+    """
     model = DahlCatheter(params, n_elements)
     model.run(path[:10])
     best = np.inf
