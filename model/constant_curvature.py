@@ -30,6 +30,15 @@ def tendons_from_articulation(theta_rad: float, plane_rad: float, tendon_offset_
     return tendon_offset_mm * theta_rad * np.cos(TENDON_ANGLES_RAD - plane_rad) + pretension_mm
 
 
+def tip_from_tendons_mm(tendons_mm, insertion_mm: float, tendon_offset_mm: float) -> np.ndarray:
+    """Tip position [mm] in the base frame of the arc the tendons bend (free length insertion_mm)."""
+    bx, by = bend_from_tendons(tendons_mm, tendon_offset_mm)
+    rot = np.empty((3, 3))
+    tip = np.empty(3)
+    arc_transform(bx, by, float(insertion_mm), rot, tip)
+    return tip
+
+
 class ConstantCurvature:
     """Constant-curvature map from tendon displacements and free length to the catheter shape."""
 
@@ -38,11 +47,7 @@ class ConstantCurvature:
 
     def tip_mm(self, tendons_mm, insertion_mm: float) -> np.ndarray:
         """Tip position [mm] in the base frame."""
-        bx, by = bend_from_tendons(tendons_mm, self.params.tendon_offset_mm)
-        rot = np.empty((3, 3))
-        tip = np.empty(3)
-        arc_transform(bx, by, float(insertion_mm), rot, tip)
-        return tip
+        return tip_from_tendons_mm(tendons_mm, insertion_mm, self.params.tendon_offset_mm)
 
     def backbone_mm(self, tendons_mm, insertion_mm: float, n_points: int = 21) -> np.ndarray:
         """(n_points, 3) points evenly spaced along the arc from the tube exit to the tip."""

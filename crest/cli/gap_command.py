@@ -2,6 +2,7 @@
 
     crest gap TRAIN.csv [...] --holdout TEST.csv [...] --json OUT.json --report DIR
     crest gap --blind-benchmark --cases 40 --seed S --json OUT.json --report DIR
+    crest gap --real-data [DIR] --json OUT.json: every real log held out once (crest.gap.real_data_table)
     either with --scheduler tcp://HOST:PORT: the fits run on a Dask cluster (crest.gap.fit_executor)
 """
 from __future__ import annotations
@@ -17,6 +18,7 @@ from crest.gap.blind_benchmark import run_blind_benchmark
 from crest.gap.fit_executor import check_scheduler_address, dask_executor, open_executor
 from crest.gap.log_diagnosis import diagnose_logs
 from crest.gap.log_recordings import load_recordings
+from crest.gap.real_data_table import real_data_table, table_markdown
 from crest.reports.blind_report import write_blind_report
 from crest.reports.gap_report import sampling_lines, write_gap_report
 from model.gap.diagnosis import DiagnosisSettings
@@ -36,6 +38,10 @@ def add_parser(sub) -> None:
                              "--workers local processes; the result is the same")
     parser.add_argument("--blind-benchmark", action="store_true",
                         help="validate instead on virtual-testbed logs whose effect is withheld")
+    parser.add_argument("--real-data", nargs="?", const="", default=None, metavar="DIR",
+                        help="tabulate calibrated constant curvature, calibrated Dahl and Dahl + verdict as held-out "
+                             "RMSE for every real log in DIR (default ../shared/data/continuum_nathan), each held "
+                             "out once in a two-fold cross-validation over the files")
     parser.add_argument("--cases", type=int, default=40, help="blind benchmark: number of cases (default 40)")
     parser.add_argument("--seed", type=int, default=0, help="blind benchmark: random seed")
     parser.add_argument("--family", choices=("dahl", "rod", "both"), default="dahl",
@@ -57,6 +63,18 @@ def run(args: argparse.Namespace) -> int:
     if args.scheduler is not None:
         check_scheduler_address(args.scheduler)
     settings = DiagnosisSettings(workers=args.workers)
+    if args.real_data is not None:
+        if args.train or args.holdout or args.blind_benchmark:
+            raise ValueError("--real-data makes its own folds of the real logs; do not pass logs or --blind-benchmark")
+        with open_executor(args.scheduler, args.workers) as executor:
+            table = real_data_table(Path(args.real_data) if args.real_data else None, settings, _progress, executor)
+        _write_json(table, args.json_path)
+        if args.report:
+            args.report.mkdir(parents=True, exist_ok=True)
+            (args.report / "real_data_table.md").write_text(table_markdown(table) + "\n")
+            print(f"report written to {args.report / 'real_data_table.md'}")
+        print(table_markdown(table))
+        return 0
     if args.blind_benchmark:
         if args.train or args.holdout:
             raise ValueError("--blind-benchmark makes its own logs; do not pass training or held-out logs")
@@ -102,8 +120,10 @@ def _write_json(result: dict, path: Path | None) -> None:
 
 def format_verdict(result: dict) -> str:
     verdict = result["verdict"]
+    cc = result["constant_curvature"]
     lines = [f"baseline: train {result['baseline']['train_rmse_mm']:.3f} mm, held-out "
-             f"{result['baseline']['holdout_rmse_mm']:.3f} mm RMS",
+             f"{result['baseline']['holdout_rmse_mm']:.3f} mm RMS (calibrated constant curvature: train "
+             f"{cc['train_rmse_mm']:.3f} mm, held-out {cc['holdout_rmse_mm']:.3f} mm)",
              "gap concentrates in: " + (", ".join(result["concentrated"][:5]) or "no region"),
              f"verdict: {verdict['effect']}" + (f" ({' + '.join(verdict['effects'])})" if len(verdict["effects"]) > 1
                                                 else ""),

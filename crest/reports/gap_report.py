@@ -114,6 +114,11 @@ def markdown(result: dict) -> str:
              + (f"{floor:.3f} mm" if floor is not None else "unknown (no static holds in the logs)")]
     for effect_id, params in verdict["params"].items():
         lines.append(f"- {effect_id}: " + ", ".join(f"{k} = {v:.4g}" for k, v in params.items()))
+    lines += ["", "Held-out tip RMSE per recording (all evaluated rows), against calibrated constant curvature:", "",
+              "| recording | calibrated CC | calibrated Dahl | Dahl + verdict |", "|---|---|---|---|"]
+    lines += [f"| {row['recording']} | {row['constant_curvature_mm']:.3f} mm | {row['baseline_mm']:.3f} mm | "
+              f"{row['verdict_mm']:.3f} mm |" for row in result["holdout_by_recording"]]
+    lines.append("")
     if verdict["model_form_rms_mm"] is not None:
         lines.append(f"- residual above the noise floor after the verdict (model form, what no effect in the "
                      f"catalog removed): {verdict['model_form_rms_mm']:.3f} mm RMS, concentrated in "

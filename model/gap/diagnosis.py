@@ -1,6 +1,7 @@
 """The gap diagnosis: baseline, where the gap lies, which effect explains it, how far it shrinks.
 
-1. Baseline: calibrate the base model on the training recordings; tip RMSE on training and held-out.
+1. Baseline: calibrate the base model on the training recordings; tip RMSE on training and held-out,
+   beside calibrated constant curvature (`cc_calibration`), the reference it must beat.
 2. Where: break the held-out residual down by region (`regions`) and compute its signatures.
 3. Which: fit every candidate effect (and a plain refit, the control) in parallel, rank them by
    held-out score (`candidates`); the best is chosen only if it removes more than noise can
@@ -25,6 +26,7 @@ import numpy as np
 
 from model.effects.catalog import EFFECTS
 from model.gap.calibration import ModelFit, calibrate_base, rmse_mm, tip_errors
+from model.gap.cc_calibration import calibrate_constant_curvature
 from model.gap.candidates import (CANDIDATE_ITERATIONS, CONTINUE, EXPLORE, PROBE, CandidateResult, FitTask,
                                   evaluate, ranked, run_tasks)
 from model.gap.finite_json import finite_tree
@@ -67,8 +69,11 @@ def diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: Ca
     results are taken in submission order, so they do not depend on the executor. Default: a
     process pool of `settings.workers` made here (none for one worker).
 
-    Returns {"format", "baseline", "where", "concentrated", "signatures", "candidates", "pairs",
-    "verdict", "settings", "sampling", "timing_s"}; "verdict" holds "effect" (best id or "none"),
+    Returns {"format", "baseline", "constant_curvature", "holdout_by_recording", "where", "concentrated",
+    "signatures", "candidates", "pairs", "verdict", "settings", "sampling", "timing_s"}; "constant_curvature"
+    is the calibrated constant-curvature reference (`cc_calibration`) on the same rows, and
+    "holdout_by_recording" the held-out tip RMSE of each held-out recording (all its evaluated rows) for
+    constant curvature, the baseline and the baseline with the verdict's effects; "verdict" holds "effect" (best id or "none"),
     "effects" (all selected), "holdout_rmse_before_mm", "holdout_rmse_after_mm" and "shrink" (0..1);
     "sampling" says which rows of the logs the fits and the held-out evaluation used
     (`Resolution.sampling`: decimation, the training cap).
@@ -96,6 +101,8 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
     base_errors = _holdout_errors(baseline, held, res)
     split = split_holdout([len(e) for e in base_errors])
     noise = tracker_noise_mm(list(train) + list(holdout))
+    reference = calibrate_constant_curvature(res.prepare_training(train), prior)   # what Dahl must beat
+    reference_errors = reference.tip_errors(held)
     timing["baseline"] = time.perf_counter() - clock
 
     def task(effects: dict, start: ModelFit, mode: str = EXPLORE) -> FitTask:
@@ -221,6 +228,13 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
                      "noise_floor_mm": None if noise is None else float(np.sqrt(3) * noise),
                      "residual_significant": is_significant_residual(base_rmse, noise),
                      "fit": baseline.as_dict()},
+        "constant_curvature": {**reference.as_dict(), "holdout_rmse_mm": rmse_mm(reference_errors),
+                               "report_rmse_mm": rmse_mm(split.reported(reference_errors))},
+        "holdout_by_recording": [
+            {"recording": r.name, "rows_used_with_tip": len(cc), "constant_curvature_mm": rmse_mm([cc]),
+             "baseline_mm": rmse_mm([base]), "verdict_mm": rmse_mm([after])}
+            for r, cc, base, after in zip(held, reference_errors, base_errors,
+                                         final.holdout_errors if final else base_errors)],
         "where": where,
         "concentrated": [row["region"] for row in concentrated(where)],
         "signatures": signature,
