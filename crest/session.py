@@ -17,7 +17,6 @@ from crest.experiment.tip_feed import TipFeed
 from crest.tracker import AuroraDriver
 
 TRACKER_RATE_HZ = 40.0          # the Aurora's sample rate
-FAST_TRACKER_POLL_HZ = 400.0    # in simulated time the driver polls faster, so fresh frames come quickly
 
 
 @dataclass
@@ -72,7 +71,8 @@ def open_session(options: SessionOptions = SessionOptions()) -> Iterator[Session
         testbed = Testbed(backend.bus, config, clock=clock)
         tracker = None
         if options.tracker:
-            rate_hz = options.tracker_rate_hz if options.realtime else FAST_TRACKER_POLL_HZ
+            # in simulated time the feed asks for each frame (one per tracker period of simulated time)
+            rate_hz = options.tracker_rate_hz if options.realtime else None
             tracker = AuroraDriver(backend.tracker_port, baudrate=config.tracker.baudrate,
                                    tool_port=config.tracker.tool_port, rate_hz=rate_hz)
             tracker.start()

@@ -18,6 +18,7 @@ from crest.experiment.recorder import ExperimentRecorder
 from crest.session import open_session
 
 MOVE_SPEED_FRACTION = 0.5
+END_FRAME_TIMEOUT_S = 1.0     # longest wait for the frame that measures the end pose
 
 
 def add_parser(sub) -> None:
@@ -67,8 +68,13 @@ def run(args: argparse.Namespace) -> int:
         result = run_with_controller(session, trajectory, controller, recorder=recorder,
                                      closed_loop=args.controller == "dahl+fb", on_cycle=on_cycle)
         lost = result.tip_coverage.loss_sentence()
-        # the tracker's last frame is a measurement of the end pose only while the tracker is still there
-        tip = session.tracker.latest() if session.tracker and lost is None else None
+        # a frame requested now measures the end pose, while the tracker is still there
+        tip = None
+        if session.tracker and lost is None:
+            try:
+                tip = session.tracker.fresh_sample(END_FRAME_TIMEOUT_S)
+            except TimeoutError as exc:
+                lost = str(exc)
         if recorder:
             recorder.close()
     goal = trajectory.tip_mm[-1]

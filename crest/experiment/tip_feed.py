@@ -10,12 +10,11 @@ last valid tip, or, before the first one, since the first poll: a run whose firs
 the tool MISSING (dropout) has the same loss_timeout_s of grace as one that loses the tool later.
 
 In simulated time (`sample_period_s` given) the loop runs faster than the wall-clock tracker, so
-the feed asks for a fresh frame once per tracker period of simulated time and waits for it:
-the samples then describe the simulated catheter at that instant, as a real tracker would. The
-requests keep their phase (at k * sample_period_s), so a 40 Hz tracker gives 40 samples per
-simulated second whatever the SYNC period. The first frame to arrive may have been requested
-before the last cycle (the tracker thread polls on its own), so the feed waits for the one after
-it. A busy host may delay a frame by more than a tracker period of wall time; that is not tracker
+the feed asks for a fresh frame once per tracker period of simulated time and waits for it
+(`AuroraDriver.fresh_sample`: a frame whose TX was sent after the request; the session runs the
+driver on demand, so it sends no other TX): the samples then describe the simulated catheter at
+that instant, as a real tracker would. The requests keep their phase (at k * sample_period_s), so
+a 40 Hz tracker gives 40 samples per simulated second whatever the SYNC period. A busy host may delay a frame by more than a tracker period of wall time; that is not tracker
 loss, so the feed keeps waiting while the driver still reports TRACKING (up to
 STALLED_TRACKER_TIMEOUT_S). A busy host may even delay a reply past the driver's reply timeout,
 and the driver then reconnects within a fraction of a second: so the first time the feed finds
@@ -77,9 +76,7 @@ class TipFeed:
         elif not self._sample_due(now_s):
             return None
         else:
-            if self._wait_next() is None:          # possibly requested before now
-                return None
-            sample = self._wait_next()
+            sample = self._fresh_sample()
         if sample is None or sample.frame == self._frame:
             return None
         self._frame = sample.frame
@@ -105,12 +102,12 @@ class TipFeed:
         self._next_sample_s += (missed + 1) * self.sample_period_s
         return True
 
-    def _wait_next(self) -> TipSample | None:
-        """The next frame in wall time; None when the link is lost (see _link_up) or the frame stalls."""
+    def _fresh_sample(self) -> TipSample | None:
+        """A frame requested now; None when the link is lost (see _link_up) or the frame stalls."""
         deadline_s = time.monotonic() + STALLED_TRACKER_TIMEOUT_S
         while self._link_up():
             try:
-                return self.tracker.wait_next(FRESH_SAMPLE_WAIT_S)
+                return self.tracker.fresh_sample(FRESH_SAMPLE_WAIT_S)
             except TimeoutError:
                 if time.monotonic() > deadline_s:
                     return None

@@ -8,8 +8,9 @@ Set-up (NDI Combined API, the order ndicapi-based tools use):
     PHSR:03 ->      PENA:hhD for every handle waiting to be enabled (dynamic tracking priority)
     PHSR:04         the configured tool handle must now be enabled
     TSTART
-Then a thread sends ``TX:0001`` at ``rate_hz``, stamps each reply with time.monotonic() on arrival, checks its
-CRC and publishes a TipSample. A reply timeout, a serial error, an ERROR reply or ``max_bad_replies``
+Then a thread sends ``TX:0001`` at ``rate_hz`` (or, with ``rate_hz=None``, once per ``fresh_sample`` call: on
+demand, for a loop in simulated time that needs a frame per tracker period of its own clock and no others),
+stamps each reply with time.monotonic() on arrival, checks its CRC and publishes a TipSample. A reply timeout, a serial error, an ERROR reply or ``max_bad_replies``
 consecutive unreadable replies (bad CRC, bad widths) count as link loss: the port is closed and set-up is
 retried with exponential backoff until it succeeds or ``stop()`` is called.
 """
@@ -97,7 +98,7 @@ class AuroraDriver:
         port: serial device, e.g. ``/dev/ttyUSB0`` or a simulator's pseudo-terminal.
         baudrate: the rate to run at after set-up (``[tracker].baudrate``); one of COMM_BAUD_CODES.
         tool_port: the sensor's port handle as two hex digits (``[tracker].tool_port``), e.g. ``"0A"``.
-        rate_hz: TX polling rate.
+        rate_hz: TX polling rate; None: no polling, one TX per ``fresh_sample`` call (on demand).
         reply_timeout_s: longest wait for a TX reply before the link counts as lost.
         setup_timeout_s: longest wait for a reply to a set-up command (PINIT can take a second on hardware).
         max_bad_replies: consecutive unreadable replies (bad CRC or format) that count as link loss.
@@ -105,7 +106,7 @@ class AuroraDriver:
         on_state: called from the driver thread with (state, reason) on every state change.
     """
 
-    def __init__(self, port: str, *, baudrate: int = 115200, tool_port: str = "0A", rate_hz: float = 40.0,
+    def __init__(self, port: str, *, baudrate: int = 115200, tool_port: str = "0A", rate_hz: float | None = 40.0,
                  reply_timeout_s: float = 0.2, setup_timeout_s: float = 3.0, max_bad_replies: int = 3,
                  backoff_s: float = 0.1, max_backoff_s: float = 2.0,
                  on_state: Callable[[TrackerState, str], None] | None = None):
@@ -116,13 +117,13 @@ class AuroraDriver:
                 and all(c in string.hexdigits for c in tool_port) and tool_port != "00"):
             raise ValueError(f"[tracker].tool_port {tool_port!r} is not a port handle: use two hex digits, e.g. \"0A\"")
         self.tool_handle = int(tool_port, 16)
-        if rate_hz <= 0.0:
-            raise ValueError(f"tracker rate_hz must be > 0, got {rate_hz}")
+        if rate_hz is not None and not rate_hz > 0.0:
+            raise ValueError(f"tracker rate_hz must be > 0 (or None: on demand), got {rate_hz}")
         if max_bad_replies < 1:
             raise ValueError(f"tracker max_bad_replies must be >= 1, got {max_bad_replies}")
         self.port = port
         self.baudrate = baudrate
-        self.period_s = 1.0 / rate_hz
+        self.period_s = None if rate_hz is None else 1.0 / rate_hz
         self.reply_timeout_s = reply_timeout_s
         self.setup_timeout_s = setup_timeout_s
         self.max_bad_replies = max_bad_replies
@@ -134,6 +135,8 @@ class AuroraDriver:
         self._thread: threading.Thread | None = None
         self._changed = threading.Condition()
         self._latest: TipSample | None = None
+        self._latest_sent_s = -float("inf")     # when the TX of the latest sample was sent (monotonic)
+        self._wanted = threading.Event()        # on demand: a fresh_sample call waits for a TX
         self._last_valid_t_s: float | None = None
         self._stats = TrackerStats()
         self._state = TrackerState.STOPPED
@@ -166,6 +169,7 @@ class AuroraDriver:
         Returns once the exchange in progress has ended: within one reply or set-up timeout.
         """
         self._stop.set()
+        self._wanted.set()          # an on-demand thread waiting for a request wakes and sees the stop
         if self._thread is not None:
             self._thread.join()
         if self._serial is not None:
@@ -199,6 +203,17 @@ class AuroraDriver:
             before = self._latest
             if not self._changed.wait_for(lambda: self._latest is not before, timeout_s):
                 raise TimeoutError(f"tracker on {self.port}: no new sample within {timeout_s} s "
+                                   f"(state {self._state.value}, last error: {self.last_error or 'none'})")
+            return self._latest
+
+    def fresh_sample(self, timeout_s: float) -> TipSample:
+        """Block until a sample whose TX was sent after this call is published (on demand: ask for it);
+        TimeoutError after ``timeout_s``. Its tip describes the tracked tool at or after the call."""
+        called_s = time.monotonic()
+        with self._changed:
+            self._wanted.set()
+            if not self._changed.wait_for(lambda: self._latest_sent_s >= called_s, timeout_s):
+                raise TimeoutError(f"tracker on {self.port}: no sample requested after the call within {timeout_s} s "
                                    f"(state {self._state.value}, last error: {self.last_error or 'none'})")
             return self._latest
 
@@ -286,10 +301,17 @@ class AuroraDriver:
                 self._reconnect()
 
     def _poll(self) -> None:
-        """Poll TX until the link is lost (raises) or stop is requested."""
+        """Poll TX until the link is lost (raises) or stop is requested: at rate_hz, or on demand once per
+        request (a request made during an exchange gets the next one)."""
         bad_in_a_row = 0
         deadline_s = time.monotonic()
         while not self._stop.is_set():
+            if self.period_s is None:
+                self._wanted.wait()
+                self._wanted.clear()
+                if self._stop.is_set():
+                    return
+            sent_s = time.monotonic()
             raw = self._command("TX:0001", self.reply_timeout_s)
             t_s = time.monotonic()
             try:
@@ -305,15 +327,20 @@ class AuroraDriver:
                     raise TrackerProtocolError(f"{bad_in_a_row} unreadable replies in a row, last: {exc}") from exc
             else:
                 bad_in_a_row = 0
-                self._publish(t_s, record)
+                self._publish(t_s, record, sent_s)
+            if self.period_s is None:
+                if bad_in_a_row:
+                    self._wanted.set()   # an unreadable reply answered no request: ask again
+                continue
             deadline_s = max(deadline_s + self.period_s, time.monotonic())  # late: no catch-up burst
             self._stop.wait(deadline_s - time.monotonic())
 
-    def _publish(self, t_s: float, record: reply.HandleRecord) -> None:
+    def _publish(self, t_s: float, record: reply.HandleRecord, sent_s: float) -> None:
         tip_mm = np.array(record.position_mm) if record.state is ToolState.VALID else None
         sample = TipSample(t_s, tip_mm, record.frame, record.port_status)
         with self._changed:
             self._latest = sample
+            self._latest_sent_s = sent_s
             if tip_mm is not None:
                 self._last_valid_t_s = t_s
             self._stats = _bump(self._stats, samples=True, missing=tip_mm is None)

@@ -170,3 +170,30 @@ def test_no_sample_yet_means_infinite_age(sim):
 def test_invalid_settings_name_the_field(kwargs, match):
     with pytest.raises(ValueError, match=match):
         AuroraDriver("/dev/null", **kwargs)
+
+
+def test_on_demand_the_driver_sends_one_tx_per_request_and_its_frame_sees_the_tool_after_the_request(sim, tip):
+    """rate_hz=None (the session's mode in simulated time): no polling; each fresh_sample sends one TX,
+    so the frame describes the tool as it was when asked, whatever the wall time between requests."""
+    driver = AuroraDriver(sim.port_name, **{**FAST, "rate_hz": None}).start()
+    try:
+        tx_before = sum(c.name == "TX" for c in sim.command_log)
+        threading.Event().wait(0.3)                                   # nobody asks: nothing is sent
+        assert sum(c.name == "TX" for c in sim.command_log) == tx_before
+        frames = []
+        for k in range(5):
+            tip.set([float(k), 0.0, 70.0])
+            sample = driver.fresh_sample(WAIT_S)
+            assert np.allclose(sample.tip_mm, [float(k), 0.0, 70.0], atol=1e-9)
+            frames.append(sample.frame)
+        assert sum(c.name == "TX" for c in sim.command_log) == tx_before + 5
+        assert frames == sorted(set(frames))
+    finally:
+        driver.stop()
+    assert driver.state is TrackerState.STOPPED
+
+
+def test_polling_a_fresh_sample_is_one_requested_after_the_call(tip, driver):
+    driver.wait_next(WAIT_S)
+    tip.set([-1.0, 2.0, 75.5])
+    assert np.allclose(driver.fresh_sample(WAIT_S).tip_mm, [-1.0, 2.0, 75.5], atol=1e-9)
