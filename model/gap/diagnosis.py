@@ -123,7 +123,8 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
     best_base, best_errors = min([(fit, errors) for fit, errors in bases if np.isfinite(rmse_mm(errors))],
                                  key=lambda pair: pair[0].train_rmse_mm)
     if best_base is not baseline:
-        say(f"baseline: improved from {baseline.train_rmse_mm:.3f} to {best_base.train_rmse_mm:.3f} mm (training)")
+        say(f"baseline: improved from {baseline.train_rmse_mm:.4f} to {best_base.train_rmse_mm:.4f} mm (training; "
+            f"{'the plain refit' if best_base is refit.fit else 'a candidate with its effect switched off'})")
         baseline, base_errors = best_base, best_errors
         singles = [replace(evaluate(r.effects, r.fit, r.holdout_errors, base_errors, split), seconds=r.seconds,
                            ablated_train_rmse_mm=r.ablated_train_rmse_mm,
