@@ -67,12 +67,14 @@ def run(args: argparse.Namespace) -> int:
         if args.train or args.holdout or args.blind_benchmark:
             raise ValueError("--real-data makes its own folds of the real logs; do not pass logs or --blind-benchmark")
         with open_executor(args.scheduler, args.workers) as executor:
-            table = real_data_table(Path(args.real_data) if args.real_data else None, settings, _progress, executor)
+            table = real_data_table(Path(args.real_data) if args.real_data else None, settings, _progress, executor,
+                                    report_dir=args.report)
         _write_json(table, args.json_path)
         if args.report:
             args.report.mkdir(parents=True, exist_ok=True)
             (args.report / "real_data_table.md").write_text(table_markdown(table) + "\n")
-            print(f"report written to {args.report / 'real_data_table.md'}")
+            print(f"report written to {args.report / 'real_data_table.md'} (each fold's gap report in "
+                  f"{args.report / 'fold_K'})")
         print(table_markdown(table))
         return 0
     if args.blind_benchmark:

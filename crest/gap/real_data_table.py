@@ -25,8 +25,10 @@ from concurrent.futures import Executor
 from pathlib import Path
 
 from crest.gap.log_diagnosis import diagnose_logs
+from crest.gap.log_recordings import load_recordings
 from crest.gap.real_bench_log import real_data_missing
 from crest.importers.continuum_nathan import default_data_dir, import_all
+from crest.reports.gap_report import write_gap_report
 from model.gap.diagnosis import DiagnosisSettings
 
 FORMAT = "crest-real-data-table/1"
@@ -40,8 +42,9 @@ def folds(paths: list[Path]) -> list[list[Path]]:
 
 
 def real_data_table(data_dir: Path | None, settings: DiagnosisSettings, progress: Callable[[str], None],
-                    executor: Executor | None = None) -> dict:
-    """Import the real data, diagnose each fold held out against the other, and tabulate per file.
+                    executor: Executor | None = None, report_dir: Path | None = None) -> dict:
+    """Import the real data, diagnose each fold held out against the other, and tabulate per file;
+    with report_dir, each fold's gap report (`crest gap --report`) goes to report_dir/fold_K.
 
     Returns {"format", "data_dir", "rows": [{"recording", "fold", "trained_on", "constant_curvature_mm",
     "dahl_mm", "dahl_verdict_mm", "verdict"}], "diagnoses": [the diagnosis result of each fold]}.
@@ -63,6 +66,8 @@ def real_data_table(data_dir: Path | None, settings: DiagnosisSettings, progress
             result = diagnose_logs(train, held, settings=settings, executor=executor,
                                    progress=lambda message, k=k: progress(f"fold {k + 1}: {message}"))
             diagnoses.append(result)
+            if report_dir is not None:
+                write_gap_report(result, load_recordings(held), Path(report_dir) / f"fold_{k + 1}")
             for row in result["holdout_by_recording"]:
                 rows.append({"recording": Path(row["recording"]).stem, "fold": k + 1,
                              "trained_on": [p.stem for p in train],
