@@ -4,8 +4,9 @@ All drives share one python-can ``virtual`` bus instance and one canopen.Network
 (its notifier thread runs their callbacks). A client (the crest driver, or
 canopen.RemoteNode / BaseNode402 in tests) opens its own
 ``can.Bus(interface="virtual", channel=<same channel>)`` and talks to them as to
-hardware. A third bus instance on the channel feeds the bus-load meter, so it
-sees every frame, the drives' included.
+hardware. Whoever wants the bus load opens a handle of its own on the channel with a
+``sim_backend.bus_load.BusLoadMeter`` (as `crest bench` does): every further handle costs
+each frame a copy and a thread wake-up, so the drives keep none for it.
 
 ``tick(now_s)`` (s since the testbed started) drives the drives' time-based
 duties and fires scheduled per-axis faults; SYNC frames from the client drive
@@ -21,7 +22,6 @@ from typing import Callable, Iterable, Sequence
 import can
 import canopen
 
-from sim_backend.bus_load import BusLoadMeter, BusLoadReport
 from sim_backend.drive.drive_spec import DriveSpec
 from sim_backend.drive.sim_drive import SYNC_COB_ID, SimDrive
 from sim_backend.faults import FaultSchedule, FaultSpec
@@ -34,13 +34,12 @@ NOTIFIER_POLL_S = 0.05
 class SimDriveSet:
     """Drives for ``specs`` on the virtual CAN channel ``channel``.
 
-    :param bitrate_bit_s, sync_period_s: the bus and SYNC timing the bus load is measured against.
     :param faults: per-axis faults to inject at their time; tracker faults are ignored here.
     :param faults_held: their clock waits for ``start_fault_clock`` (see ``FaultSchedule``).
     """
 
-    def __init__(self, specs: Sequence[DriveSpec], channel: str, *, bitrate_bit_s: int = 1_000_000,
-                 sync_period_s: float = 0.01, faults: Iterable[FaultSpec] = (), faults_held: bool = False) -> None:
+    def __init__(self, specs: Sequence[DriveSpec], channel: str, *, faults: Iterable[FaultSpec] = (),
+                 faults_held: bool = False) -> None:
         _check_unique(specs)
         self.channel = channel
         self.drives: dict[str, SimDrive] = {spec.name: SimDrive(spec) for spec in specs}
@@ -50,12 +49,8 @@ class SimDriveSet:
                 raise ValueError(f"fault {fault}: no drive named {fault.axis!r}; "
                                  f"drives are {', '.join(self.drives)}")
         self._schedule = FaultSchedule(drive_faults, held=faults_held)
-        self.sync_period_s = sync_period_s
         self._sync_listeners: list[Callable[[int, bytearray, float], None]] = []
-        self.bus_load = BusLoadMeter(bitrate_bit_s, sync_period_s)
         self._network: canopen.Network | None = None
-        self._meter_bus: can.BusABC | None = None
-        self._meter_notifier: can.Notifier | None = None
 
     def drive(self, name: str) -> SimDrive:
         try:
@@ -74,8 +69,6 @@ class SimDriveSet:
 
     def start(self) -> None:
         """Open the bus, attach the drives and power them on (each sends its boot-up message)."""
-        self._meter_bus = can.Bus(interface="virtual", channel=self.channel)
-        self._meter_notifier = can.Notifier(self._meter_bus, [self.bus_load], timeout=NOTIFIER_POLL_S)
         self._network = canopen.Network(can.Bus(interface="virtual", channel=self.channel))
         self._network.NOTIFIER_CYCLE = NOTIFIER_POLL_S
         self._network.connect()
@@ -90,12 +83,6 @@ class SimDriveSet:
         if self._network is not None:
             self._network.disconnect()
             self._network = None
-        if self._meter_notifier is not None:
-            self._meter_notifier.stop()
-            self._meter_notifier = None
-        if self._meter_bus is not None:
-            self._meter_bus.shutdown()
-            self._meter_bus = None
 
     def __enter__(self) -> SimDriveSet:
         self.start()
@@ -113,9 +100,6 @@ class SimDriveSet:
             self.drives[fault.axis].inject_fault(fault.kind)
         for drive in self.drives.values():
             drive.tick(now_s)
-
-    def bus_load_report(self) -> BusLoadReport:
-        return self.bus_load.report()
 
 
 def _check_unique(specs: Sequence[DriveSpec]) -> None:

@@ -40,7 +40,7 @@ class TrackerSettings:
 
 class VirtualTestbed:
     def __init__(self, drive_specs: Sequence[DriveSpec], channel: str, plant: Plant, *,
-                 bitrate_bit_s: int = 1_000_000, sync_period_s: float = 0.01,
+                 sync_period_s: float = 0.01,
                  tracker: TrackerSettings = TrackerSettings(), faults: Sequence[FaultSpec] = (),
                  faults_wait_for_run: bool = False, plant_in_thread: bool = False):
         names = {spec.name for spec in drive_specs}
@@ -49,8 +49,7 @@ class VirtualTestbed:
             raise ValueError(f"the virtual testbed needs drives named {sorted(missing)}")
         self.channel = channel
         self.sync_period_s = sync_period_s
-        self.drives = SimDriveSet(drive_specs, channel, bitrate_bit_s=bitrate_bit_s,
-                                  sync_period_s=sync_period_s, faults=faults, faults_held=faults_wait_for_run)
+        self.drives = SimDriveSet(drive_specs, channel, faults=faults, faults_held=faults_wait_for_run)
         self._tracker_faults = FaultSchedule([f for f in faults if f.targets_tracker], held=faults_wait_for_run)
         self.plant_runner = PlantRunner(plant, self._tendon_positions_mm(), self._insertion_position_mm())
         self.plant_in_thread = plant_in_thread
@@ -147,6 +146,3 @@ class VirtualTestbed:
     def plant_rate_hz(self) -> float:
         """Steps per second the plant achieved (in thread mode), else SYNCs per second."""
         return self.plant_runner.achieved_rate_hz
-
-    def bus_load_report(self):
-        return self.drives.bus_load_report()

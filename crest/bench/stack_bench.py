@@ -19,6 +19,7 @@ from crest.experiment.controlled_run import run_with_controller
 from crest.experiment.workspace_from_config import limits_for, workspace_for
 from crest.session import SessionOptions, open_session
 from model import CatheterParams
+from sim_backend.bus_load import BusLoadMeter
 
 SYNC_COB_ID = 0x80
 
@@ -49,13 +50,14 @@ def full_stack(sync_rate_hz: float = 500.0, duration_s: float = 60.0, controller
         session.testbed.home()
         monitor = session.backend.monitor_bus()
         listener = SyncTimes()
-        notifier = can.Notifier(monitor, [listener], timeout=0.1)
+        meter = BusLoadMeter(config.bus.bitrate, period_s)      # what the frames on the wire take
+        notifier = can.Notifier(monitor, [listener, meter], timeout=0.1)
         try:
             result = run_with_controller(session, trajectory, controller)
         finally:
             notifier.stop()
             monitor.shutdown()
-        load = session.backend.virtual.bus_load_report()
+        load = meter.report()
         plant_rate_hz = session.backend.virtual.plant_rate_hz
     stamps = np.array(listener.timestamps)
     periods = np.diff(stamps)

@@ -94,8 +94,7 @@ class Rig:
         self.recorder = FrameRecorder()
         self._recorder_bus = can.Bus(interface="virtual", channel=self.channel)
         self._recorder_notifier = can.Notifier(self._recorder_bus, [self.recorder], timeout=0.05)
-        self.drives = SimDriveSet(specs, self.channel, bitrate_bit_s=config.bus.bitrate,
-                                  sync_period_s=config.sync.period_s, faults=faults)
+        self.drives = SimDriveSet(specs, self.channel, faults=faults)
         self.drives.start()
         self.bus = can.Bus(interface="virtual", channel=self.channel)
         self.clock = SteppedClock(on_advance=self.drives.tick)
