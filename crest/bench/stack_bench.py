@@ -1,23 +1,32 @@
-"""The full stack on the virtual testbed: five drives, a controller and the tracker at a fast SYNC.
+"""The full stack on the virtual testbed: five drives, a controller and the tracker at a fast SYNC,
+with the testbed in a process of its own (across a process boundary, as on a real bus) or in the
+master's process.
 
-Measured from the SYNC frames on the bus (a second handle on the virtual bus timestamps them):
+Measured from the SYNC frames on the bus (a further handle on the bus timestamps them):
 the achieved rate, the period jitter (|period - nominal|, p50/p99), missed cycles (a period
 longer than 1.5 nominal periods) and the bus load the traffic would put on a real bus.
 """
 from __future__ import annotations
 
-import dataclasses
+import os
+import re
+import shutil
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
 
 import can
 import numpy as np
 
 from control import Articulation, make_controller
-from crest.config import load_testbed_config
-from crest.config.testbed_config import SyncConfig
+from crest.config import default_config_path, load_testbed_config
+from crest.driver import SafetyStop
 from crest.experiment.builtin_trajectories import BuiltinOptions, builtin_trajectory
 from crest.experiment.controlled_run import run_with_controller
 from crest.experiment.workspace_from_config import limits_for, workspace_for
 from crest.session import SessionOptions, open_session
+from crest.testbed_service.auto_start import MODE_VARIABLE
 from model import CatheterParams
 from sim_backend.bus_load import BusLoadMeter
 
@@ -33,9 +42,51 @@ class SyncTimes(can.Listener):
             self.timestamps.append(msg.timestamp)
 
 
-def full_stack(sync_rate_hz: float = 500.0, duration_s: float = 60.0, controller_name: str = "dahl") -> dict:
-    config = load_testbed_config()
-    config = dataclasses.replace(config, sync=SyncConfig(period_s=1.0 / sync_rate_hz))
+def full_stack(sync_rate_hz: float = 500.0, duration_s: float = 60.0, controller_name: str = "dahl",
+               testbed_process: bool = True) -> dict:
+    """The dahl circle at `sync_rate_hz`, with the virtual testbed in a process of its own (the master
+    reaches its drives over the served bus, as it reaches drives on a real bus) or in this one.
+
+    The served testbed runs the configuration file of this rate (configs/testbed.toml with the SYNC
+    period changed, written to a temporary folder): a testbed process reads its configuration from
+    a file. A run that a safety stop ends (a heartbeat lost when the processes cannot keep up) is
+    measured up to the stop and reported with its cause.
+    """
+    with tempfile.TemporaryDirectory(prefix="crest-stack-") as folder:
+        config = load_testbed_config(_config_at_rate(Path(folder), sync_rate_hz))
+        with _testbed_mode("process" if testbed_process else "in-process"):
+            result = _measure(config, sync_rate_hz, duration_s, controller_name)
+    return {**result, "testbed": "its own process" if testbed_process else "this process"}
+
+
+def _config_at_rate(folder: Path, sync_rate_hz: float) -> Path:
+    """configs/testbed.toml (with its drive EDS) in `folder`, its SYNC period set to 1/sync_rate_hz."""
+    source = default_config_path()
+    text, count = re.subn(r"^period_s = \S+", f"period_s = {1.0 / sync_rate_hz!r}", source.read_text(),
+                          flags=re.MULTILINE)
+    if count != 1:
+        raise ValueError(f"{source}: expected one [sync] period_s line, found {count}")
+    shutil.copy(source.parent / "crest_drive.eds", folder / "crest_drive.eds")
+    path = folder / "testbed.toml"
+    path.write_text(text)
+    return path
+
+
+@contextmanager
+def _testbed_mode(mode: str) -> Iterator[None]:
+    """CREST_VIRTUAL_TESTBED for the session opened inside (see crest.testbed_service.auto_start)."""
+    before = os.environ.get(MODE_VARIABLE)
+    os.environ[MODE_VARIABLE] = mode
+    try:
+        yield
+    finally:
+        if before is None:
+            del os.environ[MODE_VARIABLE]
+        else:
+            os.environ[MODE_VARIABLE] = before
+
+
+def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: str) -> dict:
     params = CatheterParams.from_toml()
     workspace, limits = workspace_for(config, params), limits_for(config)
     period_s = config.sync.period_s
@@ -46,6 +97,7 @@ def full_stack(sync_rate_hz: float = 500.0, duration_s: float = 60.0, controller
                                     BuiltinOptions(articulation_deg=90.0, periods=turns,
                                                    circle_period_s=circle_period_s), period_s, start)
     controller = make_controller(controller_name, workspace, limits, period_s)
+    stopped, rms_tip_error_mm = None, None
     with open_session(SessionOptions(config=config)) as session:
         session.testbed.home()
         monitor = session.backend.monitor_bus()
@@ -53,12 +105,14 @@ def full_stack(sync_rate_hz: float = 500.0, duration_s: float = 60.0, controller
         meter = BusLoadMeter(config.bus.bitrate, period_s)      # what the frames on the wire take
         notifier = can.Notifier(monitor, [listener, meter], timeout=0.1)
         try:
-            result = run_with_controller(session, trajectory, controller)
+            rms_tip_error_mm = run_with_controller(session, trajectory, controller).rms_tip_error_mm
+        except SafetyStop as stop:
+            stopped = str(stop)
         finally:
             notifier.stop()
             monitor.shutdown()
         load = meter.report()
-        plant_rate_hz = session.backend.virtual.plant_rate_hz
+        plant_rate_hz = session.backend.virtual.plant_rate_hz if session.backend.virtual is not None else None
     stamps = np.array(listener.timestamps)
     periods = np.diff(stamps)
     jitter = np.abs(periods - period_s)
@@ -71,5 +125,5 @@ def full_stack(sync_rate_hz: float = 500.0, duration_s: float = 60.0, controller
             "missed_cycles": missed, "longest_period_ms": float(1e3 * periods.max()),
             "bus_load_mean": float(load.mean_load), "bus_load_max": float(load.max_load),
             "bus_bitrate_bit_s": int(load.bitrate_bit_s), "cycles_over_bus_capacity": len(load.overloaded),
-            "rms_tip_error_mm": result.rms_tip_error_mm, "plant_rate_hz": plant_rate_hz,
+            "rms_tip_error_mm": rms_tip_error_mm, "plant_rate_hz": plant_rate_hz, "stopped": stopped,
             "goal": "500 Hz with no missed cycle and p99 jitter <= 1 ms"}

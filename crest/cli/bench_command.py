@@ -25,7 +25,8 @@ def add_parser(sub) -> None:
     parser.add_argument("--only", nargs="+", choices=SECTIONS, default=list(SECTIONS),
                         help="run only these sections")
     parser.add_argument("--stack-seconds", type=float, default=60.0,
-                        help="duration of the full-stack run at 500 Hz SYNC (default 60)")
+                        help="duration of each full-stack run (default 60): 500 Hz and 1 kHz SYNC with the testbed "
+                             "in a process of its own, and 500 Hz with it in the master's process")
     parser.add_argument("--view-seconds", type=float, default=20.0,
                         help="duration of each control-loop run without and with the live view (default 20)")
     parser.add_argument("--gap-seed", type=int, default=0,
@@ -53,8 +54,10 @@ def run(args: argparse.Namespace) -> int:
         "move": lambda: model_bench.quasi_static_move(params),
         "controllers": lambda: controller_cycle_times(params),
         "rod_plant": lambda: plant_bench.rod_plant(),
-        "full_stack": lambda: {f"{rate:.0f}_hz": stack_bench.full_stack(rate, args.stack_seconds)
-                               for rate in (500.0, 250.0)},
+        "full_stack": lambda: {
+            **{f"{rate:.0f}_hz_testbed_process": stack_bench.full_stack(rate, args.stack_seconds, testbed_process=True)
+               for rate in (500.0, 1000.0)},
+            "500_hz_one_process": stack_bench.full_stack(500.0, args.stack_seconds, testbed_process=False)},
         "gap": lambda: diagnosis_benchmarks(args.gap_seed, args.real_data, cases=args.gap_cases,
                                             progress=lambda message: print(f"crest bench: {message}",
                                                                            file=sys.stderr, flush=True)),
@@ -99,10 +102,12 @@ def format_table(results: dict) -> str:
                      f"({r['step_rate_per_cpu_s']:.0f} steps per CPU second)",
                      f">= {r['goal_step_rate_hz']:.0f} steps/s", r["step_rate_hz"] >= r["goal_step_rate_hz"]))
     for key, r in results.get("full_stack", {}).items():
-        rows.append((f"Full stack at {r['sync_rate_hz_nominal']:.0f} Hz SYNC, {r['duration_s']:.0f} s",
+        rows.append((f"Full stack at {r['sync_rate_hz_nominal']:.0f} Hz SYNC, {r['duration_s']:.0f} s, testbed in "
+                     f"{r['testbed']}",
                      f"{r['achieved_rate_hz']:.0f} Hz, jitter p50 {r['jitter_p50_ms']:.2f} / p99 "
                      f"{r['jitter_p99_ms']:.2f} ms, {r['missed_cycles']} missed, bus load "
-                     f"{100 * r['bus_load_mean']:.0f}% of {r['bus_bitrate_bit_s'] / 1e6:g} Mbit/s",
+                     f"{100 * r['bus_load_mean']:.0f}% of {r['bus_bitrate_bit_s'] / 1e6:g} Mbit/s"
+                     + (f"; stopped: {r['stopped']}" if r["stopped"] else ""),
                      "rate held, 0 missed, p99 <= 1 ms",
                      r["missed_cycles"] == 0 and r["jitter_p99_ms"] <= 1.0))
     notes = []
