@@ -25,6 +25,23 @@ def test_noise_floor_from_static_holds_is_the_tracker_noise():
     assert tracker_noise_mm([recording(t, tendon, tip)]) == pytest.approx(0.15, rel=0.1)
 
 
+def test_static_poses_of_a_repeated_sweep_tell_the_noise_from_the_second_repetition_on():
+    """Poses one per second (too slow for the moving estimate, never held), the sweep run four times:
+    a pose of a later run is reached along the same path as the run before, so the repeat
+    differences are noise. The first run starts from rest (a transient of 2 mm here), which the
+    estimate leaves out."""
+    rng = np.random.default_rng(1)
+    steps, runs = 64, 4
+    phase = np.tile(2 * np.pi * np.arange(steps) / steps, runs)
+    tendon = 1.5 * np.column_stack([np.cos(phase), np.sin(phase), -np.cos(phase), -np.sin(phase)])
+    t = np.arange(len(phase), dtype=float)
+    true_tip = np.column_stack([20 * np.cos(phase), 20 * np.sin(phase), np.full(len(phase), 70.0)])
+    true_tip[:steps, 0] += 2.0 * np.exp(-np.arange(steps) / 10.0)          # the first run's transient
+    tip = true_tip + rng.normal(0.0, 0.2, true_tip.shape)
+    assert tracker_noise_mm([recording(t, tendon, tip)]) == pytest.approx(0.2, rel=0.15)
+    assert tracker_noise_mm([recording(t[:steps], tendon[:steps], tip[:steps])]) is None   # one run: no estimate
+
+
 def test_play_in_the_drive_train_shows_as_a_dead_band_of_its_width():
     """With backlash w the tip does not move for about w of tendon travel after each reversal."""
     params = CatheterParams.from_toml()
