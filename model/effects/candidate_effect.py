@@ -55,9 +55,13 @@ class CandidateEffect:
         return values
 
     def at_limit(self, values: tuple[float, ...], tolerance: float = 0.01) -> list[str]:
-        """Names of the parameters within `tolerance` of the range width of a bound other than 0."""
+        """Names of the parameters at a bound other than 0: within `tolerance` of the range width and
+        of the bound itself, |value - bound| <= tolerance * min(high - low, |bound|). A range over
+        orders of magnitude (a time from 0.01 s to 5 s) would otherwise put a fifth of its decade next
+        to the small bound: 0.056 s counted as at 0.01 s, and a true 0.057 s lag was rejected."""
         return [name for name, value, low, high in zip(self.param_names, values, self.lower, self.upper)
-                if any(bound != 0.0 and abs(value - bound) <= tolerance * (high - low) for bound in (low, high))]
+                if any(bound != 0.0 and abs(value - bound) <= tolerance * min(high - low, abs(bound))
+                       for bound in (low, high))]
 
     def terms(self, values: tuple[float, ...], base: EffectTerms = EffectTerms()) -> EffectTerms:
         """`base` with this effect switched on at `values`."""

@@ -20,6 +20,14 @@ def test_a_fit_at_the_limit_of_its_physical_range_is_implausible():
     assert range_reasons("backlash", (0.0,)) == []                 # 0 is 'off', not a limit
 
 
+def test_a_short_lag_in_a_range_over_decades_is_not_at_its_limit():
+    """rate_lag.time_s spans 0.01-5 s: 0.057 s is well inside (a fifth of the range's width below 0.06 s
+    used to count as 'at 0.01 s'), 0.0100 s is at the limit."""
+    assert range_reasons("rate_lag", (0.05, 0.057)) == []
+    reasons = range_reasons("rate_lag", (0.05, 0.01))
+    assert len(reasons) == 1 and "time_s" in reasons[0] and "limit" in reasons[0]
+
+
 def test_gravity_that_only_improves_bent_samples_does_not_match_its_signature():
     """Sag is present at zero load: a 'gravity' fit whose gain lies only where the catheter is bent
     absorbs something else."""
