@@ -14,8 +14,9 @@ the feed asks for a fresh frame once per tracker period of simulated time and wa
 (`AuroraDriver.fresh_sample`: a frame whose TX was sent after the request; the session runs the
 driver on demand, so it sends no other TX): the samples then describe the simulated catheter at
 that instant, as a real tracker would. The requests keep their phase (at k * sample_period_s), so
-a 40 Hz tracker gives 40 samples per simulated second whatever the SYNC period. A busy host may delay a frame by more than a tracker period of wall time; that is not tracker
-loss, so the feed keeps waiting while the driver still reports TRACKING (up to
+a 40 Hz tracker gives 40 samples per simulated second whatever the SYNC period. A busy host may
+delay a frame by more than a tracker period of wall time; that is not tracker loss, so the feed
+keeps waiting while the driver still reports TRACKING (up to
 STALLED_TRACKER_TIMEOUT_S). A busy host may even delay a reply past the driver's reply timeout,
 and the driver then reconnects within a fraction of a second: so the first time the feed finds
 the link down it waits up to RECONNECT_GRACE_S of wall time for the driver to be TRACKING again,
