@@ -231,7 +231,8 @@ def _virtual_testbed(config: TestbedConfig, channel: str, plant_spec: str | None
     described_plant, tracker = load_plant_description(plant_toml, effects)
     plant = load_plant(plant_spec) if plant_spec else described_plant
     specs = [_drive_spec(config, axis) for axis in config.axes]
-    return VirtualTestbed(specs, channel, plant, sync_period_s=config.sync.period_s, faults=faults, faults_wait_for_run=True,
+    return VirtualTestbed(specs, channel, plant, sync_period_s=config.sync.period_s, faults=faults,
+                          faults_wait_for_run=True,
                           tracker=TrackerSettings(
                               tracker.noise_mm if tracker_noise_mm is None else tracker_noise_mm,
                               tracker.dropout if tracker_dropout is None else tracker_dropout,
