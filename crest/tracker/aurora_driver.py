@@ -11,8 +11,9 @@ Set-up (NDI Combined API, the order ndicapi-based tools use):
 Then a thread sends ``TX:0001`` at ``rate_hz`` (or, with ``rate_hz=None``, once per ``fresh_sample`` call: on
 demand, for a loop in simulated time that needs a frame per tracker period of its own clock and no others),
 stamps each reply with time.monotonic() on arrival, checks its CRC and publishes a TipSample. A reply
-timeout, a serial error, an ERROR reply or ``max_bad_replies`` consecutive unreadable replies (bad CRC, bad widths) count as link loss: the port is closed and set-up is
-retried with exponential backoff until it succeeds or ``stop()`` is called.
+timeout, a serial error, an ERROR reply or ``max_bad_replies`` consecutive unreadable replies (bad CRC,
+bad widths) count as link loss: the port is closed and set-up is retried with exponential backoff
+until it succeeds or ``stop()`` is called.
 """
 
 from __future__ import annotations
