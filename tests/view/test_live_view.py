@@ -31,11 +31,14 @@ EXIT_TIMEOUT_S = 60.0
 
 
 class LiveRun:
-    """A `crest run builtin:circle --view --record LOG` subprocess; its stdout read by a thread."""
+    """A `crest run builtin:circle --view --record LOG` subprocess; its stdout read by a thread.
+
+    In simulated time the run goes as fast as the host allows; it must last until the module's last
+    test presses E-STOP on a loaded machine, so it is long (the E-STOP, or the fixture, ends it)."""
 
     def __init__(self, log_path):
         self.log_path = log_path
-        self.process = start_crest("run", "builtin:circle", "--periods", "20", "--fast", "--view",
+        self.process = start_crest("run", "builtin:circle", "--periods", "100", "--fast", "--view",
                                    "--record", str(log_path),
                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         self.lines: list[str] = []
