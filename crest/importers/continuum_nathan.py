@@ -116,8 +116,12 @@ class _Poses:
 
 
 def default_data_dir() -> Path:
-    """../shared/data/continuum_nathan beside the repository that holds this package."""
-    return Path(__file__).resolve().parents[3] / "shared" / "data" / "continuum_nathan"
+    """../shared/data/continuum_nathan beside the repository that holds this package, or, for an
+    installed package (which lives in site-packages, beside no repository), beside the current
+    directory; the first of the two that exists (the first when neither does)."""
+    relative = Path("shared") / "data" / "continuum_nathan"
+    candidates = [Path(__file__).resolve().parents[3] / relative, Path.cwd().resolve().parent / relative]
+    return next((path for path in candidates if path.is_dir()), candidates[0])
 
 
 def import_all(data_dir: Path | str, out_dir: Path | str, *, overwrite: bool = False) -> list[Path]:
