@@ -109,7 +109,7 @@ def real_diagnosis(data_dir: Path | None = None, workers: int = 2) -> dict:
     """The longest real log: see module doc; {"skipped": reason} without the data."""
     missing = real_data_missing(data_dir)
     if missing:
-        return {"skipped": missing}
+        return {"skipped": f"skipped: {missing}"}
     with tempfile.TemporaryDirectory(prefix="crest-gap-real-") as folder:
         logs = real_logs(Path(folder), data_dir)
         return {**timed_diagnosis(logs.train, logs.holdout, workers),

@@ -30,7 +30,7 @@ def real_data_missing(data_dir: Path | None = None) -> str | None:
     """Why the real benchmark cannot run (the folder is absent), or None."""
     folder = Path(data_dir) if data_dir else default_data_dir()
     if not (folder / "PROVENANCE.md").exists():
-        return f"skipped: no real data at {folder} (the continuum_nathan folder of ../shared/data, with PROVENANCE.md)"
+        return f"no real data at {folder} (the continuum_nathan folder of ../shared/data, with PROVENANCE.md)"
     return None
 
 

@@ -52,7 +52,7 @@ def real_data_table(data_dir: Path | None, settings: DiagnosisSettings, progress
     folder = Path(data_dir) if data_dir else default_data_dir()
     missing = real_data_missing(folder)
     if missing:
-        raise FileNotFoundError(missing.replace("skipped: ", ""))
+        raise FileNotFoundError(missing)
     rows, diagnoses = [], []
     with tempfile.TemporaryDirectory(prefix="crest-real-data-") as tmp:
         with warnings.catch_warnings():
