@@ -61,22 +61,21 @@ def compose_backbone(bend_rad, length_mm, points_mm, frames) -> None:
     the orientation at the base of element i (frames[N] at the tip).
     """
     n = bend_rad.shape[0]
-    rot = frames[0]
     for a in range(3):
         points_mm[0, a] = 0.0
         for b in range(3):
-            rot[a, b] = 1.0 if a == b else 0.0
-    local_rot = frames[0].copy()
-    local_end = points_mm[0].copy()
+            frames[0, a, b] = 1.0 if a == b else 0.0
     for i in range(n):
+        # the arc's own rotation and end go into frames[i+1] and points[i+1] first, and are
+        # then turned into the base frame in place, column by column (no scratch arrays: this
+        # runs once per model step)
+        local_rot = frames[i + 1]
+        local_end = points_mm[i + 1]
         arc_transform(bend_rad[i, 0], bend_rad[i, 1], length_mm[i], local_rot, local_end)
+        e0, e1, e2 = local_end[0], local_end[1], local_end[2]
         for a in range(3):
-            acc = 0.0
-            for b in range(3):
-                acc += frames[i, a, b] * local_end[b]
-            points_mm[i + 1, a] = points_mm[i, a] + acc
-            for b in range(3):
-                acc = 0.0
-                for k in range(3):
-                    acc += frames[i, a, k] * local_rot[k, b]
-                frames[i + 1, a, b] = acc
+            points_mm[i + 1, a] = points_mm[i, a] + (frames[i, a, 0] * e0 + frames[i, a, 1] * e1 + frames[i, a, 2] * e2)
+        for b in range(3):
+            r0, r1, r2 = local_rot[0, b], local_rot[1, b], local_rot[2, b]
+            for a in range(3):
+                frames[i + 1, a, b] = frames[i, a, 0] * r0 + frames[i, a, 1] * r1 + frames[i, a, 2] * r2

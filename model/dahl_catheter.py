@@ -44,6 +44,7 @@ class CatheterState:
     sliding_mm: np.ndarray          # (4, N) tendon sliding past each element, toward the base
     last_step_mm: np.ndarray        # (4, N) sliding increment of the last step (predicts the next)
     tension_n: np.ndarray           # (4, N) mean tendon tension over each element
+    last_tension_step_n: np.ndarray  # (4, N) change of that tension in the last step (predicts the next)
     bend_rad: np.ndarray            # (N, 2) element bend vectors
     compression_mm: np.ndarray      # (N,) element axial compression
     tip_tension_n: np.ndarray       # (4,) tension at the tip anchor
@@ -61,7 +62,7 @@ class CatheterState:
         points = np.zeros((n + 1, 3))
         points[:, 2] = np.linspace(0.0, free_length_mm, n + 1)
         return cls(np.zeros(4), np.array([float(free_length_mm)]), np.zeros((4, n)), np.zeros((4, n)),
-                   np.zeros((4, n)), np.zeros((4, n)), np.zeros((n, 2)), np.zeros(n), np.zeros(4),
+                   np.zeros((4, n)), np.zeros((4, n)), np.zeros((4, n)), np.zeros((n, 2)), np.zeros(n), np.zeros(4),
                    np.zeros(4), np.zeros(4, dtype=np.bool_), points, np.tile(np.eye(3), (n + 1, 1, 1)),
                    np.zeros(N_SCALARS), np.zeros((n, 2)), np.zeros(4))
 
@@ -90,7 +91,7 @@ class DahlCatheter:
     moments, by backward Euler (implicit, L-stable) in steps of at most `max_time_step_s`;
     `move_to` is a move to rest (the quasi-static limit). Math: quasi_static_kernel.dynamic_bend_offset.
     The default 10 ms is one step per sample at 100 Hz. With a 20 ms damping time and the catheter's
-    own mass, its tip follows a 1.25 ms reference within 0.04 mm RMS (0.11 mm at most) on a
+    own mass, its tip follows a 1.25 ms reference within 0.04 mm RMS (0.13 mm at most) on a
     multisine pulling at up to 18 mm/s and on a 120 deg step; 5 ms steps gave 0.025 mm RMS at twice
     the cost (tests/model/test_dynamics.py::test_ten_ms_steps_follow_a_fine_time_step).
     """
@@ -217,8 +218,9 @@ class DahlCatheter:
         done = run_path(tendons, insertion, dt_s, self.max_tendon_step_mm, self.max_insertion_step_mm,
                         self.max_newton_iterations, max_solver_iterations, self._kernel_params,
                         self._kernel_effects, self._point_loads, s.applied_tendon_mm, s.applied_insertion_mm,
-                        s.friction_n, s.sliding_mm, s.last_step_mm, s.tension_n, s.bend_rad, s.compression_mm,
-                        s.tip_tension_n, s.drive_tension_n, s.slack, s.points_mm, s.frames, s.diagnostics, tips,
+                        s.friction_n, s.sliding_mm, s.last_step_mm, s.tension_n, s.last_tension_step_n,
+                        s.bend_rad, s.compression_mm, s.tip_tension_n, s.drive_tension_n, s.slack, s.points_mm,
+                        s.frames, s.diagnostics, tips,
                         self.max_time_step_s, s.bend_rate_rad_s, s.drive_creep_mm)
         if done < len(tendons):
             self.state = before

@@ -459,8 +459,8 @@ def make_workspace(n):
 
 @kernel
 def quasi_static_step(u, length, rate_scale, params, effects, point_loads, friction, sliding, last_step, tension,
-                      bend, compression, tip_tension, drive_tension, slack, points, frames, scalars, work,
-                      max_iterations, commit_unconverged, dt_s, bend_rate, creep):
+                      last_tension_step, bend, compression, tip_tension, drive_tension, slack, points, frames,
+                      scalars, work, max_iterations, commit_unconverged, dt_s, bend_rate, creep, extrapolate):
     """Advance the catheter state to equilibrium at tendon input u [mm] and free length [mm].
 
     In the dynamic mode (damping time or inertia scale > 0, see `has_dynamics`) the step is one
@@ -468,6 +468,7 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
     the stiffness and bend offset of `dynamic_bend_offset`; bend_rate [rad/s] is then updated.
     Without it, bend_rate is not touched and the step is the static solve, whatever dt_s is.
     creep [mm]: the drive line's creep stretch (`drive_creep`), updated over dt_s.
+    extrapolate: start Newton from the last step's tension trend (see below; False on a retry).
 
     `rate_scale[k]` multiplies tendon k's friction strength (rate friction, 1 without it).
     `work` is scratch space from make_workspace. Returns
@@ -506,24 +507,30 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
         sin_phi[i, 0], sin_phi[i, 1], sin_phi[i, 2], sin_phi[i, 3] = s, c, -s, -c
 
     # Linearisation of each friction element about (x_ref, T_ref, theta_ref, F0). First guess: this
-    # step slides as far as the last one did (constant velocity) at the last tensions; then Newton
-    # updates from the exact Dahl integration at each iterate. theta_ref is the bend this step's
-    # own bend map gives at T_ref,
+    # step slides as far as the last one did (constant velocity), at the last tensions plus, in the
+    # dynamic mode, the last step's change of them,
+    #     T_ref = T + dT_last   (dT_last = 0 in the quasi-static mode, see the commit below);
+    # then Newton updates from the exact Dahl integration at each iterate. theta_ref is the bend
+    # this step's own bend map gives at T_ref,
     #     b_ref = b_rest + offset + (r/K_step) sum_k T_ref,k e_k,
     # the map the sweep linearises (theta - theta_ref = w . (T - T_ref)). In the quasi-static mode
     # under unchanged loads that is the last bend; in the dynamic mode the last bend is off it by
     # the damper and inertia forces, and linearising there cost a second Newton iteration in most
-    # steps (1.7 iterations per 10 ms step on the benchmark path; 1.14 about b_ref).
-    tref[:, :] = tension
+    # steps (1.7 iterations per 10 ms step on the benchmark path; 1.14 about b_ref at the last
+    # tensions, 1.07 with the tension trend).
+    for i in range(n):
+        for k in range(4):
+            predicted = tension[k, i] + last_tension_step[k, i]
+            tref[k, i] = predicted if (extrapolate and predicted > 0.0) else tension[k, i]
     for i in range(n):
         along0 = 0.0
         along1 = 0.0
         for k in range(4):
-            along0 += tension[k, i] * cos_phi[i, k]
-            along1 += tension[k, i] * sin_phi[i, k]
+            along0 += tref[k, i] * cos_phi[i, k]
+            along1 += tref[k, i] * sin_phi[i, k]
         _linearise_element(i, rest_bend[i, 0] + offset[i, 0] + arm[i] / kb_step * along0,
                            rest_bend[i, 1] + offset[i, 1] + arm[i] / kb_step * along1, mu, fsc, sigma, alpha,
-                           rate_scale, friction, last_step, tension, slack, f0, kx, gt, gth, bend_dir)
+                           rate_scale, friction, last_step, tref, slack, f0, kx, gt, gth, bend_dir)
         for k in range(4):
             xref[k, i] = sliding[k, i] + last_step[k, i]
 
@@ -652,6 +659,15 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
         drive = tip_tension[k]
         for i in range(n):
             last_step[k, i] = new_sliding[k, i] - sliding[k, i]
+            # The tension trend for the next step's first guess: only in the dynamic mode, where the
+            # dampers make tensions evolve smoothly in time. Under quasi-static holds and reversals
+            # it is a poor guess; on a near-Coulomb stick-slip reversal it led Newton to a garbage
+            # iterate (test_friction_never_pushes_a_tendon_even_when_it_dominates). No trend either
+            # after an unconverged solve, a tendon going slack or taut, or a jump of more than
+            # MAX_TENSION_STEP_N (a step input's transient, not a trend).
+            change = new_tension[k, i] - tension[k, i]
+            trend = dynamic and converged and slack[k] == slack_before[k] and abs(change) < MAX_TENSION_STEP_N
+            last_tension_step[k, i] = change if trend else 0.0
             friction[k, i] = new_force[k, i]
             sliding[k, i] = new_sliding[k, i]
             tension[k, i] = new_tension[k, i]
@@ -671,7 +687,7 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
 
 
 @kernel
-def remap_to_length(old_length, new_length, friction, sliding, last_step, tension):
+def remap_to_length(old_length, new_length, friction, sliding, last_step, tension, last_tension_step):
     """Carry the friction state along the material when the free length changes.
 
     The tendons are driven from the insertion block, so they move with the catheter body:
@@ -689,6 +705,7 @@ def remap_to_length(old_length, new_length, friction, sliding, last_step, tensio
     old_sliding = sliding.copy()
     old_last_step = last_step.copy()
     old_tension = tension.copy()
+    old_tension_step = last_tension_step.copy()
     for i in range(n):
         tau = new_length - (i + 0.5) * h_new
         # fractional index in the old elements: tau = L_old - (j + 1/2) h_old
@@ -700,11 +717,13 @@ def remap_to_length(old_length, new_length, friction, sliding, last_step, tensio
                 sliding[k, i] = old_sliding[k, 0]
                 last_step[k, i] = old_last_step[k, 0]
                 tension[k, i] = old_tension[k, 0]
+                last_tension_step[k, i] = old_tension_step[k, 0]
             elif j >= n - 1:
                 friction[k, i] = old_force[k, n - 1] / h_old * h_new
                 sliding[k, i] = old_sliding[k, n - 1]
                 last_step[k, i] = old_last_step[k, n - 1]
                 tension[k, i] = old_tension[k, n - 1]
+                last_tension_step[k, i] = old_tension_step[k, n - 1]
             else:
                 j0 = int(j)
                 w = j - j0
@@ -712,13 +731,14 @@ def remap_to_length(old_length, new_length, friction, sliding, last_step, tensio
                 sliding[k, i] = (1 - w) * old_sliding[k, j0] + w * old_sliding[k, j0 + 1]
                 last_step[k, i] = (1 - w) * old_last_step[k, j0] + w * old_last_step[k, j0 + 1]
                 tension[k, i] = (1 - w) * old_tension[k, j0] + w * old_tension[k, j0 + 1]
+                last_tension_step[k, i] = (1 - w) * old_tension_step[k, j0] + w * old_tension_step[k, j0 + 1]
 
 
 @kernel
 def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_step_mm, max_iterations,
              iteration_budget, params, effects, point_loads, applied_tendon_mm, applied_insertion_mm, friction,
-             sliding, last_step, tension, bend, compression, tip_tension, drive_tension, slack, points, frames,
-             scalars, tips_out, max_time_step_s, bend_rate, creep):
+             sliding, last_step, tension, last_tension_step, bend, compression, tip_tension, drive_tension, slack,
+             points, frames, scalars, tips_out, max_time_step_s, bend_rate, creep):
     """Drive the model along a sampled input path; tips_out[t] is the tip after sample t.
 
     Returns the number of samples done: all of them, unless the Newton iterations of this call
@@ -730,7 +750,8 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
     point_loads (K, 4): external point forces (fx, fy, fz [N], distance from the tip [mm]).
     Each sample is split into sub-steps of at most max_tendon_step_mm / max_insertion_step_mm
     so that the friction state follows the path (history) and not just its end point; a sub-step
-    whose Newton solve needs more than max_iterations is retried in halves.
+    whose Newton solve needs more than max_iterations is retried in halves (in the dynamic mode,
+    starting Newton from the last tensions rather than their trend).
 
     Rate friction scales tendon k's friction strength by s_k = 1 + c_rate*|v_k| over the
     sample, v_k = (u_k(t) - u_k(t-1)) / dt_s its pull speed past the drive-train play (0 for
@@ -746,6 +767,7 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
     n_samples = tendon_mm.shape[0]
     target = np.empty(4)
     u = np.empty(4)
+    start = np.empty(4)
     rate_scale = np.ones(4)
     rate_per_mm = effects[E_RATE] / dt_s if (dt_s > 0.0 and math.isfinite(dt_s)) else 0.0
     work = make_workspace(bend.shape[0])
@@ -764,11 +786,12 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
         if dynamic and math.isfinite(dt_s):
             n_sub = max(n_sub, int(math.ceil(dt_s / max_time_step_s - 1e-9)))
         start_length = applied_insertion_mm[0]
-        start = applied_tendon_mm.copy()
+        start[:] = applied_tendon_mm
         length = start_length
         # Advance through the fraction w of the sample; a sub-step whose Newton solve does not
         # converge (a sharp friction reversal) is halved, down to 1/2^MAX_HALVINGS of a sub-step.
         done = 0.0
+        retry = False
         fraction = 1.0 / n_sub
         smallest = fraction / 2.0 ** MAX_HALVINGS
         while done < 1.0 - 1e-12:
@@ -778,15 +801,17 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
                 u[k] = start[k] + w * (target[k] - start[k])
             previous_length = length
             length = start_length + w * (length_target - start_length)
-            remap_to_length(previous_length, length, friction, sliding, last_step, tension)
+            remap_to_length(previous_length, length, friction, sliding, last_step, tension, last_tension_step)
             if quasi_static_step(u, length, rate_scale, params, effects, point_loads, friction, sliding,
-                                 last_step, tension, bend, compression, tip_tension, drive_tension, slack, points,
-                                 frames, scalars, work, max_iterations, fraction <= smallest, fraction * dt_s,
-                                 bend_rate, creep):
+                                 last_step, tension, last_tension_step, bend, compression, tip_tension,
+                                 drive_tension, slack, points, frames, scalars, work, max_iterations,
+                                 fraction <= smallest, fraction * dt_s, bend_rate, creep, not retry):
                 done = w
                 fraction = min(2.0 * fraction, 1.0 / n_sub)
+                retry = False
             else:
                 fraction *= 0.5
+                retry = True    # in halves, and Newton starts at the last tensions
             if scalars[S_ITERATIONS] > stop_at_iterations:
                 return t
         for k in range(4):
