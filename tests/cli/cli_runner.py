@@ -2,8 +2,10 @@
 from __future__ import annotations
 
 import os
+import select
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 CREST = [sys.executable, "-m", "crest.cli.main"]
@@ -22,3 +24,18 @@ def start_crest(*args: str, cwd: Path | None = None, env: dict[str, str] | None 
                 **kwargs) -> subprocess.Popen:
     env = dict(os.environ, PYTHONUNBUFFERED="1", **(env or {}))
     return subprocess.Popen([*CREST, *args], cwd=cwd or REPO, env=env, **kwargs)
+
+
+def read_until(fd, needle: bytes, timeout_s: float) -> bytes:
+    """Read a pseudo-terminal `fd` until `needle` has appeared; returns all it read (fails after timeout_s)."""
+    out = b""
+    deadline = time.monotonic() + timeout_s
+    while needle not in out:
+        assert time.monotonic() < deadline, f"timed out waiting for {needle!r}; got {out[-400:]!r}"
+        ready, _, _ = select.select([fd], [], [], 0.1)
+        if ready:
+            try:
+                out += os.read(fd, 4096)
+            except OSError:
+                break
+    return out

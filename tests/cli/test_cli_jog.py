@@ -1,32 +1,16 @@
 """`crest jog` driven through a pseudo-terminal, keys and all, as an operator would."""
 import os
 import pty
-import select
 import subprocess
-import time
 
 import numpy as np
 import pytest
 
-from cli_runner import CREST, REPO
+from cli_runner import CREST, REPO, read_until
 from crest.exit_codes import ExitCode
 from crest.log import read_log
 
 STARTUP_TIMEOUT_S = 300.0
-
-
-def read_until(fd, needle: bytes, timeout_s: float) -> bytes:
-    out = b""
-    deadline = time.monotonic() + timeout_s
-    while needle not in out:
-        assert time.monotonic() < deadline, f"timed out waiting for {needle!r}; got {out[-400:]!r}"
-        ready, _, _ = select.select([fd], [], [], 0.1)
-        if ready:
-            try:
-                out += os.read(fd, 4096)
-            except OSError:
-                break
-    return out
 
 
 def start_jog(*args: str) -> tuple[int, subprocess.Popen]:
