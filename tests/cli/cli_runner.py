@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import os
+import pty
 import select
 import subprocess
 import sys
@@ -39,3 +40,20 @@ def read_until(fd, needle: bytes, timeout_s: float) -> bytes:
             except OSError:
                 break
     return out
+
+
+def on_a_terminal(command: list[str], env: dict[str, str] | None = None) -> tuple[int, subprocess.Popen]:
+    """`command` with a pseudo-terminal as stdin, stdout and stderr: (the terminal's fd, process)."""
+    master, slave = pty.openpty()
+    env = dict(os.environ, TERM="xterm", PYTHONUNBUFFERED="1", **(env or {}))
+    process = subprocess.Popen(command, cwd=REPO, env=env, stdin=slave, stdout=slave, stderr=slave, close_fds=True)
+    os.close(slave)
+    return master, process
+
+
+def close_terminal(master: int, process: subprocess.Popen) -> None:
+    """Close the terminal and kill the process if it still runs (a test that failed midway)."""
+    os.close(master)
+    if process.poll() is None:
+        process.kill()
+        process.wait()

@@ -1,12 +1,11 @@
 """`crest jog` driven through a pseudo-terminal, keys and all, as an operator would."""
 import os
-import pty
 import subprocess
 
 import numpy as np
 import pytest
 
-from cli_runner import CREST, REPO, read_until
+from cli_runner import CREST, close_terminal, on_a_terminal, read_until
 from crest.exit_codes import ExitCode
 from crest.log import read_log
 
@@ -15,17 +14,7 @@ STARTUP_TIMEOUT_S = 300.0
 
 def start_jog(*args: str) -> tuple[int, subprocess.Popen]:
     """`crest jog --fast ARGS` on a pseudo-terminal, as an operator runs it: (the terminal's fd, process)."""
-    master, slave = pty.openpty()
-    process = subprocess.Popen([*CREST, "jog", "--fast", *args], cwd=REPO,
-                               stdin=slave, stdout=slave, stderr=slave, close_fds=True)
-    os.close(slave)
-    return master, process
-
-
-def end_jog(master: int, process: subprocess.Popen) -> None:
-    os.close(master)
-    if process.poll() is None:
-        process.kill()
+    return on_a_terminal([*CREST, "jog", "--fast", *args])
 
 
 def test_jog_moves_pitch_and_insertion_and_releases_on_quit(tmp_path):
@@ -42,7 +31,7 @@ def test_jog_moves_pitch_and_insertion_and_releases_on_quit(tmp_path):
         out += read_until(master, b"released", timeout_s=60)
         assert process.wait(timeout=60) == 0
     finally:
-        end_jog(master, process)
+        close_terminal(master, process)
     log = read_log(tmp_path / "jog.csv")
     assert log.tendon_cmd_mm[-1, 0] > log.tendon_cmd_mm[-1, 2]     # tendon 1 pulled, tendon 3 paid out
     assert log.insertion_cmd_mm[-1] > log.insertion_cmd_mm[0]
@@ -65,7 +54,7 @@ def test_jog_pulling_one_tendon_pays_out_its_partner_and_stops_short_of_the_tens
         out += read_until(master, b"released", timeout_s=60)
         assert process.wait(timeout=60) == 0
     finally:
-        end_jog(master, process)
+        close_terminal(master, process)
     assert b"tension limit: tendon1" in out
     log = read_log(tmp_path / "jog.csv")
     assert log.tendon_force_n.max() < 40.0                               # never near the safety stop
@@ -81,6 +70,6 @@ def test_a_safety_stop_during_jog_starts_its_message_on_a_new_line():
         out += read_until(master, b"all axes were quick-stopped", timeout_s=120)
         assert process.wait(timeout=60) == ExitCode.EMCY
     finally:
-        end_jog(master, process)
+        close_terminal(master, process)
     before_stop = out[:out.index(b"crest: safety stop")]
     assert before_stop.endswith(b"\n"), before_stop[-200:]       # not appended to the status line

@@ -4,35 +4,17 @@ python-can's `can.viewer` watching a run's bus, and `crest jog` driving the serv
 The served testbed, every run and every tool are processes of their own (see served_testbed).
 """
 import os
-import pty
 import re
-import subprocess
 import sys
 
 from crest.exit_codes import ExitCode
 from crest.log import read_log
 from served_testbed import crest_lines, start_run, start_served_testbed, status_rows, stop
-from tests.cli.cli_runner import CREST, REPO, read_until
+from tests.cli.cli_runner import CREST, close_terminal, on_a_terminal, read_until
 
 AXES = ("tendon1", "tendon2", "tendon3", "tendon4", "insertion")
 NODE_IDS = (1, 2, 3, 4, 5)
 STARTUP_TIMEOUT_S = 300.0      # a fresh checkout compiles the model kernel first
-
-
-def on_a_terminal(command: list[str], env: dict[str, str]) -> tuple[int, subprocess.Popen]:
-    """`command` with a pseudo-terminal as stdin, stdout and stderr: (the terminal's fd, process)."""
-    master, slave = pty.openpty()
-    process = subprocess.Popen(command, cwd=REPO, env=dict(os.environ, TERM="xterm", PYTHONUNBUFFERED="1", **env),
-                               stdin=slave, stdout=slave, stderr=slave, close_fds=True)
-    os.close(slave)
-    return master, process
-
-
-def close_terminal(master: int, process: subprocess.Popen) -> None:
-    os.close(master)
-    if process.poll() is None:
-        process.kill()
-        process.wait()
 
 
 def test_can_viewer_shows_the_sync_and_every_drives_pdos_of_a_run_and_quits_on_q(tmp_path):
