@@ -2,14 +2,12 @@
 (`family = "rod"`), recorded through the real pipeline (`record_excitation` on the virtual testbed,
 short excitation, simulated time), then `diagnose_logs` on the two files. One fixed-seed case per
 verdict kind: an effect, `none` and `unexplained`; the JSON is strict and finite."""
-import dataclasses
 import functools
 import json
 import tempfile
 from pathlib import Path
 
 from crest.config import load_testbed_config
-from crest.config.testbed_config import SyncConfig
 from crest.experiment.excitation_run import plan_excitation, record_excitation
 from crest.gap.log_diagnosis import diagnose_logs
 from crest.session import SessionOptions, open_session
@@ -33,12 +31,8 @@ seed = 5
 
 @functools.cache
 def rod_diagnosis(effects: str = "", noise_mm: float = 0.05) -> dict:
-    """The diagnosis of the short excitation recorded on a rod plant with `effects` (TOML lines).
-
-    The testbed runs SYNC at 50 Hz instead of the configured 100 Hz: the recording takes 60% of the
-    time, and the diagnosis fits at 5 Hz (TEST_SETTINGS) either way."""
-    prior = CatheterParams.from_toml()
-    config = dataclasses.replace(load_testbed_config(), sync=SyncConfig(period_s=0.02))
+    """The diagnosis of the short excitation recorded on a rod plant with `effects` (TOML lines)."""
+    prior, config = CatheterParams.from_toml(), load_testbed_config()
     with tempfile.TemporaryDirectory() as folder:
         plant = Path(folder) / "rod_plant.toml"
         plant.write_text(ROD_PLANT.format(effects=effects, noise_mm=noise_mm))
