@@ -74,9 +74,9 @@ def diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: Ca
     is the calibrated constant-curvature reference (`cc_calibration`) on the same rows, and
     "holdout_by_recording" the held-out tip RMSE of each held-out recording (all its evaluated rows) for
     constant curvature, the baseline and the baseline with the verdict's effects; "verdict" holds
-    "effect" (best id or "none"), "effects" (all selected), "holdout_rmse_before_mm", "holdout_rmse_after_mm" and "shrink" (0..1);
-    "sampling" says which rows of the logs the fits and the held-out evaluation used
-    (`Resolution.sampling`: decimation, the training cap).
+    "effect" (best id or "none"), "effects" (all selected), "holdout_rmse_before_mm",
+    "holdout_rmse_after_mm" and "shrink" (0..1); "sampling" says which rows of the logs the fits and
+    the held-out evaluation used (`Resolution.sampling`: decimation, the training cap).
     """
     if not train or not holdout:
         raise RecordingError("the diagnosis needs at least one training and one held-out recording")
