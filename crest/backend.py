@@ -6,9 +6,11 @@ This is the one place in crest that may import sim_backend. Everything above it 
 The virtual testbed ([bus] interface = "virtual") is found in one of two places. When a served
 one runs (`crest testbed serve`, its own process; see crest.testbed_service), the commands join it
 through python-can's "remote" interface on the channel its state file names, as they would join a
-hardware bus. Otherwise a command boots its own: inside its process, on the in-process bus, or,
-with CREST_VIRTUAL_TESTBED=process, in a served testbed process of its own that ends with it
-(crest.testbed_service.auto_start).
+hardware bus. Otherwise a real-time command starts a served testbed process of its own, which ends
+with it (crest.testbed_service.auto_start), and joins that. A command boots the virtual testbed
+inside its own process, on python-can's in-process bus, in simulated time (`--fast`, tests), with
+CREST_VIRTUAL_TESTBED=in-process, or where what it sets up cannot be handed to another process (a
+configuration changed in memory, the tracker's noise and dropout overridden).
 """
 from __future__ import annotations
 
@@ -23,7 +25,7 @@ import can
 from crest.config import TestbedConfig, load_testbed_config
 from crest.config.testbed_config import AxisConfig
 from crest.testbed_service import ServedTestbed, config_digest, running_testbed
-from crest.testbed_service.auto_start import OwnedTestbed, start_owned_testbed, wants_own_process
+from crest.testbed_service.auto_start import MODE_VARIABLE, OwnedTestbed, start_owned_testbed, wants_own_process
 from crest.testbed_service.served_bus import ServedBus
 
 _channel_numbers = itertools.count(1)
@@ -58,9 +60,11 @@ class Backend:
 
     def start_fault_clock(self) -> None:
         """The virtual testbed's --fault times count from now (the start of the run's motion);
-        no-op on hardware."""
+        no-op on hardware and on a served testbed this process did not start."""
         if self.virtual is not None:
             self.virtual.start_fault_clock()
+        if self.owned is not None:
+            self.owned.start_fault_clock()
 
     def tick(self, now_s: float) -> None:
         """Advance the simulator's time-based duties (deterministic use); no-op on hardware."""
@@ -85,8 +89,7 @@ def fault_kinds() -> dict[str, tuple[str, ...]]:
 
 def open_backend(config: TestbedConfig, *, plant: str | None = None, plant_config: Path | None = None,
                  faults: Sequence[str] = (), effects: dict | None = None, realtime: bool = True,
-                 plant_in_thread: bool = False, tracker_noise_mm: float | None = None,
-                 tracker_dropout: float | None = None) -> Backend:
+                 tracker_noise_mm: float | None = None, tracker_dropout: float | None = None) -> Backend:
     """Open the bus and tracker of `config`.
 
     plant ('package.module:ClassName'), plant_config (the plant description, default
@@ -110,19 +113,26 @@ def open_backend(config: TestbedConfig, *, plant: str | None = None, plant_confi
                                f"set up a virtual testbed when it starts, but a served one is running ({served.describe()}); "
                                "stop it, or pass them to `crest testbed serve`, or drop them")
         return Backend(bus=_join_served(config, served), tracker_port=served.tracker_port, served=served)
-    # serve takes the plant description and effects only; a configuration changed in memory (not
-    # its file's values) cannot be handed to a testbed process either: those stay in this process
-    if (realtime and wants_own_process() and not (plant or faults or plant_in_thread or tracker_noise_mm is not None
-                                                  or tracker_dropout is not None)
+    # a testbed process is given the configuration's file, the plant and the faults; a configuration
+    # changed in memory (not its file's values) and the tracker overrides stay in this process
+    if (realtime and wants_own_process() and tracker_noise_mm is None and tracker_dropout is None
             and config_digest(load_testbed_config(config.path)) == config_digest(config)):
-        return _open_owned(config, plant_config, effects or {})
-    return _open_virtual(config, plant, plant_config, faults, effects or {}, realtime, plant_in_thread,
-                         tracker_noise_mm, tracker_dropout)
+        return _open_owned(config, plant, plant_config, effects or {}, faults)
+    return _open_virtual(config, plant, plant_config, faults, effects or {}, realtime, tracker_noise_mm,
+                         tracker_dropout)
 
 
-def _open_owned(config: TestbedConfig, plant_config: Path | None, effects: dict) -> Backend:
-    """A served testbed process of this command's own, joined (it ends when this process does)."""
-    owned = start_owned_testbed(config.path, plant_config, effects)
+def _open_owned(config: TestbedConfig, plant: str | None, plant_config: Path | None, effects: dict,
+                faults: Sequence[str]) -> Backend:
+    """A served testbed process of this command's own, joined (it ends when this process does).
+    The faults are checked here, before the process starts, as the testbed would check them."""
+    from sim_backend.faults import parse_fault
+
+    axes = [axis.name for axis in config.axes]
+    for fault in map(parse_fault, faults):
+        if not (fault.targets_tracker or fault.axis in axes):
+            raise BackendError(f"fault {fault}: no drive named {fault.axis!r}; drives are {', '.join(axes)}")
+    owned = start_owned_testbed(config.path, plant, plant_config, effects, faults)
     try:
         bus = _join_served(config, owned.served)
     except BackendError:
@@ -134,19 +144,18 @@ def _open_owned(config: TestbedConfig, plant_config: Path | None, effects: dict)
 def join_bus(config: TestbedConfig) -> can.BusABC:
     """A handle on the CAN bus of `config` for a process beside the master (``crest estop``).
 
-    A hardware bus, or the bus of a served virtual testbed (`crest testbed serve`). A virtual
-    testbed booted inside a crest process lives on that process's in-process bus, which no other
-    process can reach: without a served testbed this raises BackendError (opening a virtual testbed
-    here would boot drives of our own and reach nobody's). The tracker is not opened.
+    A hardware bus, or the bus of a served virtual testbed (`crest testbed serve`, or the one a
+    running command started). Without one this raises BackendError (opening a virtual testbed here
+    would boot drives of our own and reach nobody's). The tracker is not opened.
     """
     if config.bus.interface != "virtual":
         return _open_hardware_bus(config)
     served = running_testbed()
     if served is None:
-        raise BackendError(f"the virtual testbed ({config.path}: [bus] interface = 'virtual') runs inside the "
-                           "crest process that started it; another process cannot reach its drives. "
-                           "Stop that run with Ctrl-C (or SIGTERM). To reach the virtual testbed from other processes, "
-                           "run it on its own: `crest testbed serve`")
+        raise BackendError(f"no virtual testbed is running ({config.path}: [bus] interface = 'virtual'): no crest "
+                           "command has started one, and none is served (`crest testbed serve`). A command in simulated "
+                           f"time (--fast) or run with {MODE_VARIABLE}=in-process keeps its testbed inside its own "
+                           "process, where no other process can reach it: stop that run with Ctrl-C (or SIGTERM)")
     return _join_served(config, served)
 
 
@@ -172,11 +181,11 @@ def _open_hardware_bus(config: TestbedConfig) -> can.BusABC:
 
 
 def _open_virtual(config: TestbedConfig, plant_spec: str | None, plant_toml: Path | None, fault_texts: Sequence[str],
-                  effects: dict, realtime: bool, plant_in_thread: bool, tracker_noise_mm: float | None,
+                  effects: dict, realtime: bool, tracker_noise_mm: float | None,
                   tracker_dropout: float | None) -> Backend:
     # The virtual bus is in-process: a channel of our own per testbed keeps testbeds apart.
     channel = f"{config.bus.channel}-{os.getpid()}-{next(_channel_numbers)}"
-    testbed = _virtual_testbed(config, channel, plant_spec, plant_toml, fault_texts, effects, plant_in_thread,
+    testbed = _virtual_testbed(config, channel, plant_spec, plant_toml, fault_texts, effects, True,
                                tracker_noise_mm, tracker_dropout)
     testbed.start(realtime=realtime)
     bus = can.Bus(interface="virtual", channel=channel, receive_own_messages=False)
@@ -198,17 +207,21 @@ class VirtualTestbedServer:
         self.testbed.stop()
 
 
-def serve_virtual_testbed(config: TestbedConfig, *, plant_config: Path | None = None, effects: dict | None = None,
+def serve_virtual_testbed(config: TestbedConfig, *, plant: str | None = None, plant_config: Path | None = None,
+                          effects: dict | None = None, faults: Sequence[str] = (), faults_wait_for_run: bool = False,
                           port: int = 0) -> VirtualTestbedServer:
     """Start the virtual testbed of `config` (real time) and serve its CAN bus on 127.0.0.1:port
-    (0: any free port) over python-can-remote. plant_config and effects as for `open_backend`."""
+    (0: any free port) over python-can-remote. plant, plant_config, effects and faults as for
+    `open_backend`; the faults' clock starts now, or with faults_wait_for_run at the testbed's
+    `start_fault_clock`."""
     from sim_backend.bus_server import BusServer
 
     if config.bus.interface != "virtual":
         raise BackendError(f"{config.path} selects the real bus '{config.bus.interface}'; only the virtual testbed "
                            "([bus] interface = 'virtual') can be served")
     channel = f"{config.bus.channel}-served-{os.getpid()}"
-    testbed = _virtual_testbed(config, channel, None, plant_config, (), effects or {}, False, None, None)
+    testbed = _virtual_testbed(config, channel, plant, plant_config, faults, effects or {}, faults_wait_for_run,
+                               None, None)
     testbed.start(realtime=True)
     try:
         server = BusServer(channel, port).start()
@@ -220,7 +233,7 @@ def serve_virtual_testbed(config: TestbedConfig, *, plant_config: Path | None = 
 
 
 def _virtual_testbed(config: TestbedConfig, channel: str, plant_spec: str | None, plant_toml: Path | None,
-                     fault_texts: Sequence[str], effects: dict, plant_in_thread: bool,
+                     fault_texts: Sequence[str], effects: dict, faults_wait_for_run: bool,
                      tracker_noise_mm: float | None, tracker_dropout: float | None):
     from sim_backend.faults import parse_fault
     from sim_backend.plant import load_plant
@@ -232,12 +245,11 @@ def _virtual_testbed(config: TestbedConfig, channel: str, plant_spec: str | None
     plant = load_plant(plant_spec) if plant_spec else described_plant
     specs = [_drive_spec(config, axis) for axis in config.axes]
     return VirtualTestbed(specs, channel, plant, sync_period_s=config.sync.period_s, faults=faults,
-                          faults_wait_for_run=True,
+                          faults_wait_for_run=faults_wait_for_run,
                           tracker=TrackerSettings(
                               tracker.noise_mm if tracker_noise_mm is None else tracker_noise_mm,
                               tracker.dropout if tracker_dropout is None else tracker_dropout,
-                              tracker.seed, int(config.tracker.tool_port, 16)),
-                          plant_in_thread=plant_in_thread)
+                              tracker.seed, int(config.tracker.tool_port, 16)))
 
 
 def _drive_spec(config: TestbedConfig, axis: AxisConfig):

@@ -25,10 +25,15 @@ def add_parser(sub) -> None:
                                              "and serve its CAN bus on 127.0.0.1 until Ctrl-C")
     serve.add_argument("--config", type=Path, default=None,
                        help="testbed configuration (default configs/testbed.toml); its [bus] must be 'virtual'")
+    serve.add_argument("--plant", default=None, metavar="MODULE:CLASS",
+                       help="the plant behind the drives (default: the plant description's)")
     serve.add_argument("--plant-config", type=Path, default=None, metavar="PLANT.toml",
                        help="the plant description (default configs/virtual_plant.toml)")
     serve.add_argument("--effect", action="append", default=[], metavar="ID[:NAME=VALUE,...]",
                        help="switch on an unmodelled effect in the plant (repeatable), as for the other commands")
+    serve.add_argument("--fault", action="append", default=[], metavar="AXIS:KIND@SECONDS",
+                       help="inject a fault (repeatable), as for the other commands; SECONDS counts from the "
+                            "testbed's start (from the start of the command's motion for a testbed a command started)")
     serve.add_argument("--port", type=_tcp_port, default=0,
                        help="TCP port of the CAN bus server on 127.0.0.1 (default 0: any free port)")
     serve.add_argument("--parent-fd", type=int, default=None, help=argparse.SUPPRESS)   # auto_start.py's pipe
@@ -51,8 +56,8 @@ def run(args: argparse.Namespace) -> int:
     config = load_testbed_config(args.config)
     effects = dict(parse_effect(text) for text in args.effect)
     try:
-        serve_until_stopped(config, plant_config=args.plant_config, effects=effects, port=args.port,
-                            on_ready=_announce, parent_fd=args.parent_fd)
+        serve_until_stopped(config, plant=args.plant, plant_config=args.plant_config, effects=effects,
+                            faults=args.fault, port=args.port, on_ready=_announce, parent_fd=args.parent_fd)
     except TestbedAlreadyServed as exc:
         print(f"crest testbed serve: {exc}", file=sys.stderr)
         return int(ExitCode.ERROR)

@@ -7,14 +7,17 @@ drives and the tracker stop, and the state file is removed before the lock is re
 
 A testbed started for one command (auto_start.py) also watches a pipe from that command: the
 kernel closes it when the command ends, however it ends (kill -9 included), and the end of the
-pipe stops the testbed as SIGTERM does, so no testbed outlives the command that started it.
+pipe stops the testbed as SIGTERM does, so no testbed outlives the command that started it. A
+byte on the pipe starts the fault clock: the command's --fault times count from its motion's
+start, as they do with the testbed inside the command. A testbed served on its own has no such
+command, and its fault times count from its start.
 """
 from __future__ import annotations
 
 import os
 import signal
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from crest.backend import serve_virtual_testbed
@@ -22,17 +25,25 @@ from crest.config import TestbedConfig
 from crest.testbed_service.state_file import ServedTestbed, claim_serving, config_digest, state_path
 
 
-def serve_until_stopped(config: TestbedConfig, *, plant_config: Path | None = None, effects: dict | None = None,
-                        port: int = 0, on_ready: Callable[[ServedTestbed, Path], None] = lambda served, path: None,
+def serve_until_stopped(config: TestbedConfig, *, plant: str | None = None, plant_config: Path | None = None,
+                        effects: dict | None = None, faults: Sequence[str] = (), port: int = 0,
+                        on_ready: Callable[[ServedTestbed, Path], None] = lambda served, path: None,
                         parent_fd: int | None = None) -> None:
     """Serve the virtual testbed of `config` until a signal's handler raises (KeyboardInterrupt
     for SIGINT, crest.driver.Terminated for SIGTERM); that exception propagates after the clean-up.
     on_ready(served, state file) is called once the state file is written. parent_fd: the read end
-    of the starting command's pipe; its end sends this process SIGTERM."""
+    of the starting command's pipe; a byte on it starts the fault clock, its end sends this process
+    SIGTERM (see module doc)."""
+    clock_requests = threading.Event()
     if parent_fd is not None:
-        threading.Thread(target=_terminate_when_closed, args=(parent_fd,), name="parent-pipe", daemon=True).start()
+        threading.Thread(target=_watch_parent, args=(parent_fd, clock_requests), name="parent-pipe",
+                         daemon=True).start()
     with claim_serving() as publish:
-        server = serve_virtual_testbed(config, plant_config=plant_config, effects=effects, port=port)
+        server = serve_virtual_testbed(config, plant=plant, plant_config=plant_config, effects=effects,
+                                       faults=faults, faults_wait_for_run=parent_fd is not None, port=port)
+        if parent_fd is not None:
+            threading.Thread(target=_start_fault_clock_when_asked, args=(clock_requests, server.testbed),
+                             name="fault-clock", daemon=True).start()
         try:
             served = ServedTestbed(pid=os.getpid(), bus_interface=server.bus_interface,
                                    bus_channel=server.bus_channel, tracker_port=server.tracker_port,
@@ -45,9 +56,15 @@ def serve_until_stopped(config: TestbedConfig, *, plant_config: Path | None = No
             server.stop()
 
 
-def _terminate_when_closed(fd: int) -> None:
-    """Read `fd` until its writer is gone, then SIGTERM this process."""
+def _watch_parent(fd: int, clock_requests: threading.Event) -> None:
+    """Read `fd` until its writer is gone, then SIGTERM this process; each byte read sets clock_requests."""
     with os.fdopen(fd, "rb", buffering=0) as pipe:
         while pipe.read(1):
-            pass
+            clock_requests.set()
     os.kill(os.getpid(), signal.SIGTERM)
+
+
+def _start_fault_clock_when_asked(clock_requests: threading.Event, testbed) -> None:
+    """Start the testbed's fault clock once the command asks (the first request counts)."""
+    clock_requests.wait()
+    testbed.start_fault_clock()

@@ -61,7 +61,9 @@ def real_bus_config(tmp_path):
     return path
 
 
-def test_estop_on_the_virtual_testbed_from_another_process_refuses_and_reaches_nothing(tmp_path):
+def test_estop_beside_a_run_in_simulated_time_refuses_and_reaches_nothing(tmp_path):
+    """A --fast run keeps its virtual testbed inside its own process: estop cannot reach it and says so.
+    (Beside a real-time run, estop reaches the drives: tests/serve.)"""
     log_path = tmp_path / "run.csv"
     run = start_recorded_run(log_path)
     try:
@@ -70,7 +72,7 @@ def test_estop_on_the_virtual_testbed_from_another_process_refuses_and_reaches_n
         assert estop.stdout == ""                              # no axis was opened, booted or stopped
         lines = crest_lines(estop.stderr)
         assert len(lines) == 1 and "Traceback" not in estop.stderr
-        assert "another process cannot reach its drives" in lines[0] and "Ctrl-C" in lines[0]
+        assert "no virtual testbed is running" in lines[0] and "--fast" in lines[0] and "Ctrl-C" in lines[0]
         # The run beside it goes on as before: still running, still writing rows.
         rows = rows_on_disk(log_path)
         deadline = time.monotonic() + 60

@@ -42,7 +42,7 @@ def test_a_killed_server_leaves_a_stale_state_file_that_nothing_joins_and_the_ne
     assert first.state_file.exists() and not process_alive(first.state["pid"])
     estop = first.crest("estop", "--config", str(first.config), timeout_s=120)
     assert estop.returncode == ExitCode.ERROR and estop.stdout == ""
-    assert "another process cannot reach its drives" in estop.stderr and "crest testbed serve" in estop.stderr
+    assert "no virtual testbed is running" in estop.stderr and "crest testbed serve" in estop.stderr
     second = start_served_testbed(tmp_path, first.config)
     try:
         assert second.state["pid"] == second.process.pid != first.process.pid
