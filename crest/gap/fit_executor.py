@@ -6,7 +6,8 @@ collects the results in the order it submitted them, and the fits draw no random
 result does not depend on which worker ran which fit or when it finished: a fixed seed gives the
 same diagnosis locally and on a cluster.
 
-`open_executor(None, workers)`: a local ProcessPoolExecutor (none for one worker), see `local_executor`.
+`open_executor(None, workers)`: a local process pool (none for one worker; one BLAS thread per
+process, `model.gap.fit_pool`), see `local_executor`.
 `open_executor("tcp://HOST:PORT")`: the executor of a `distributed.Client` connected to a running
 Dask scheduler (`Client.get_executor`; the scheduler and its workers are started with `dask
 scheduler` and `dask worker`, and the workers must be able to import this project). The address is
@@ -20,8 +21,10 @@ from __future__ import annotations
 import multiprocessing
 import re
 from collections.abc import Iterator
-from concurrent.futures import Executor, ProcessPoolExecutor
+from concurrent.futures import Executor
 from contextlib import contextmanager
+
+from model.gap.fit_pool import fit_pool, one_blas_thread
 
 CONNECT_TIMEOUT_S = 10.0
 ADDRESS = re.compile(r"tcp://(?P<host>[A-Za-z0-9.\-]+):(?P<port>[0-9]{1,5})")
@@ -54,13 +57,15 @@ def open_executor(scheduler: str | None = None, workers: int = 2) -> Iterator[Ex
 
 @contextmanager
 def local_executor(workers: int) -> Iterator[Executor | None]:
-    """`workers` local processes (None for one). Left by an exception (Ctrl-C, SIGTERM, an error), the
+    """`workers` local processes (None for one: the fits then run here, with one BLAS thread, see
+    `model.gap.fit_pool`). Left by an exception (Ctrl-C, SIGTERM, an error), the
     fits not started are cancelled and the running ones' processes terminated at once: a pool's own
     exit would wait for them, minutes on a long log."""
     if workers <= 1:
-        yield None
+        with one_blas_thread():
+            yield None
         return
-    pool = ProcessPoolExecutor(workers)
+    pool = fit_pool(workers)
     try:
         yield pool
     except BaseException:

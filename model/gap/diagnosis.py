@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import Executor, ProcessPoolExecutor
+from concurrent.futures import Executor
 from contextlib import nullcontext
 from dataclasses import asdict, dataclass, replace
 
@@ -30,6 +30,7 @@ from model.gap.cc_calibration import calibrate_constant_curvature
 from model.gap.candidates import (CANDIDATE_ITERATIONS, CONTINUE, EXPLORE, PROBE, CandidateResult, FitTask,
                                   evaluate, ranked, run_tasks)
 from model.gap.finite_json import finite_tree
+from model.gap.fit_pool import fit_pool, one_blas_thread
 from model.gap.free_parameters import base_values
 from model.gap.holdout_split import HoldoutSplit, split_holdout
 from model.gap.noise import tracker_noise_mm
@@ -67,7 +68,8 @@ def diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: Ca
 
     executor: runs the independent fits (the baseline's starts, the candidates, the pairs); the
     results are taken in submission order, so they do not depend on the executor. Default: a
-    process pool of `settings.workers` made here (none for one worker).
+    process pool of `settings.workers` made here (none for one worker; one BLAS thread per process,
+    this one included, see `model.gap.fit_pool`).
 
     Returns {"format", "baseline", "constant_curvature", "holdout_by_recording", "where", "concentrated",
     "signatures", "candidates", "pairs", "verdict", "settings", "sampling", "timing_s"}; "constant_curvature"
@@ -81,10 +83,11 @@ def diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: Ca
     if not train or not holdout:
         raise RecordingError("the diagnosis needs at least one training and one held-out recording")
     say = progress or (lambda message: None)
-    if executor is not None:
-        return _diagnose(train, holdout, prior, settings, say, executor)
-    with ProcessPoolExecutor(settings.workers) if settings.workers > 1 else nullcontext() as pool:
-        return _diagnose(train, holdout, prior, settings, say, pool)
+    with one_blas_thread():
+        if executor is not None:
+            return _diagnose(train, holdout, prior, settings, say, executor)
+        with fit_pool(settings.workers) if settings.workers > 1 else nullcontext() as pool:
+            return _diagnose(train, holdout, prior, settings, say, pool)
 
 
 def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: CatheterParams,

@@ -55,6 +55,15 @@ def assert_every_drive_quick_stopped(blf_path, silent_node: int | None = None) -
             assert state_from_statusword(statuswords[-1]) not in ENERGISED_STATES, f"node {node}"
 
 
+def sweep_with_fault(tmp_path: Path, fault: str, *options: str) -> tuple[subprocess.CompletedProcess, Path]:
+    """A real-time `crest run builtin:sweep` at the homed free length (20 mm, where the sweep starts at
+    once) with `fault` and `options`, recorded; (the finished command, its log path)."""
+    log_path = tmp_path / "run.csv"
+    result = crest("run", "builtin:sweep", "--config", str(relaxed_config(tmp_path / "config")), "--insertion-mm",
+                   "20", *options, "--fault", fault, "--record", str(log_path))
+    return result, log_path
+
+
 @pytest.mark.parametrize("fault,at_s,code,axis,silent_node", [
     ("tendon3:emcy", 3.0, ExitCode.EMCY, "tendon3", None),
     ("insertion:heartbeat", 3.0, ExitCode.HEARTBEAT_LOST, "insertion", 5),
@@ -64,10 +73,7 @@ def test_a_fault_in_the_testbed_process_stops_every_axis_with_its_exit_code_at_i
         tmp_path, own_runtime_dir, fault, at_s, code, axis, silent_node):
     """The fault's time counts from the start of the run's motion (the command tells its testbed
     process when that is), not from the testbed's start: boot and homing come first."""
-    log_path = tmp_path / "run.csv"
-    result = crest("run", "builtin:sweep", "--config", str(relaxed_config(tmp_path / "config")),
-                   "--articulation-deg", "90", "--insertion-mm", "20", "--fault", f"{fault}@{at_s}",
-                   "--record", str(log_path))
+    result, log_path = sweep_with_fault(tmp_path, f"{fault}@{at_s}", "--articulation-deg", "90")
     assert result.returncode == code, result.stderr
     lines = crest_lines(result.stderr)
     assert len(lines) == 1 and axis in lines[0] and "Traceback" not in result.stderr
@@ -109,10 +115,7 @@ def test_a_stop_signal_stops_every_axis_saves_the_log_and_ends_the_testbed_proce
 
 def test_a_drive_that_stops_answering_sdo_in_the_testbed_process_ends_in_an_sdo_safety_stop(tmp_path,
                                                                                           own_runtime_dir):
-    log_path = tmp_path / "run.csv"
-    result = crest("run", "builtin:sweep", "--config", str(relaxed_config(tmp_path / "config")),
-                   "--articulation-deg", "90", "--insertion-mm", "20", "--fault", "tendon2:sdo_timeout@1",
-                   "--record", str(log_path))
+    result, log_path = sweep_with_fault(tmp_path, "tendon2:sdo_timeout@1", "--articulation-deg", "90")
     assert result.returncode == ExitCode.SDO_FAILURE, result.stderr
     lines = crest_lines(result.stderr)
     assert len(lines) == 1 and "tendon2" in lines[0] and "SDO" in lines[0]
@@ -124,10 +127,7 @@ def test_a_drive_that_stops_answering_sdo_in_the_testbed_process_ends_in_an_sdo_
 def test_tracker_loss_in_the_testbed_process_stops_a_closed_loop_run_safely(tmp_path, own_runtime_dir):
     """The simulated tracker runs in the testbed process, on its pseudo-terminal; its loss reaches the
     command as a silent serial port."""
-    log_path = tmp_path / "run.csv"
-    result = crest("run", "builtin:sweep", "--config", str(relaxed_config(tmp_path / "config")),
-                   "--controller", "dahl+fb", "--insertion-mm", "20", "--fault", "tracker:disconnect@3.0",
-                   "--record", str(log_path))
+    result, log_path = sweep_with_fault(tmp_path, "tracker:disconnect@3.0", "--controller", "dahl+fb")
     assert result.returncode == ExitCode.TRACKER_LOST, result.stderr
     lines = crest_lines(result.stderr)
     assert len(lines) == 1 and "tracker" in lines[0].lower() and "Traceback" not in result.stderr
