@@ -125,13 +125,10 @@ def open_backend(config: TestbedConfig, *, plant: str | None = None, plant_confi
 def _open_owned(config: TestbedConfig, plant: str | None, plant_config: Path | None, effects: dict,
                 faults: Sequence[str]) -> Backend:
     """A served testbed process of this command's own, joined (it ends when this process does).
-    The faults are checked here, before the process starts, as the testbed would check them."""
-    from sim_backend.faults import parse_fault
+    The faults are checked here, before the process starts, as the testbed checks them."""
+    from sim_backend.faults import check_fault_axes, parse_fault
 
-    axes = [axis.name for axis in config.axes]
-    for fault in map(parse_fault, faults):
-        if not (fault.targets_tracker or fault.axis in axes):
-            raise BackendError(f"fault {fault}: no drive named {fault.axis!r}; drives are {', '.join(axes)}")
+    check_fault_axes([parse_fault(text) for text in faults], [axis.name for axis in config.axes])
     owned = start_owned_testbed(config.path, plant, plant_config, effects, faults)
     try:
         bus = _join_served(config, owned.served)

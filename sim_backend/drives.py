@@ -24,7 +24,7 @@ import canopen
 
 from sim_backend.drive.drive_spec import DriveSpec
 from sim_backend.drive.sim_drive import SYNC_COB_ID, SimDrive
-from sim_backend.faults import FaultSchedule, FaultSpec
+from sim_backend.faults import FaultSchedule, FaultSpec, check_fault_axes
 
 
 #: Receive poll period of the notifier threads (s): how long ``stop`` may wait for them.
@@ -44,10 +44,7 @@ class SimDriveSet:
         self.channel = channel
         self.drives: dict[str, SimDrive] = {spec.name: SimDrive(spec) for spec in specs}
         drive_faults = [fault for fault in faults if not fault.targets_tracker]
-        for fault in drive_faults:
-            if fault.axis not in self.drives:
-                raise ValueError(f"fault {fault}: no drive named {fault.axis!r}; "
-                                 f"drives are {', '.join(self.drives)}")
+        check_fault_axes(drive_faults, list(self.drives))
         self._schedule = FaultSchedule(drive_faults, held=faults_held)
         self._sync_listeners: list[Callable[[int, bytearray, float], None]] = []
         self._network: canopen.Network | None = None

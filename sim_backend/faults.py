@@ -22,6 +22,7 @@ from __future__ import annotations
 import enum
 import math
 import re
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 TRACKER_AXIS = "tracker"
@@ -63,6 +64,13 @@ class FaultSpec:
 
     def __str__(self) -> str:
         return f"{self.axis}:{self.kind.value}@{self.at_s:g}"
+
+
+def check_fault_axes(faults: Iterable[FaultSpec], drive_names: Sequence[str]) -> None:
+    """ValueError for a drive fault whose axis names none of the drives (tracker faults pass)."""
+    for fault in faults:
+        if not (fault.targets_tracker or fault.axis in drive_names):
+            raise ValueError(f"fault {fault}: no drive named {fault.axis!r}; drives are {', '.join(drive_names)}")
 
 
 def parse_fault(text: str) -> FaultSpec:

@@ -4,12 +4,18 @@ from __future__ import annotations
 import os
 import pty
 import select
+import struct
 import subprocess
 import sys
 import time
 from pathlib import Path
 
+import can
+
+from crest.driver.cia402 import ENERGISED_STATES, QUICK_STOP, state_from_statusword
+
 CREST = [sys.executable, "-m", "crest.cli.main"]
+NODE_IDS = (1, 2, 3, 4, 5)          # configs/testbed.toml, tendon1..tendon4, insertion
 REPO = Path(__file__).resolve().parents[2]
 
 
@@ -25,6 +31,18 @@ def start_crest(*args: str, cwd: Path | None = None, env: dict[str, str] | None 
                 **kwargs) -> subprocess.Popen:
     env = dict(os.environ, PYTHONUNBUFFERED="1", **(env or {}))
     return subprocess.Popen([*CREST, *args], cwd=cwd or REPO, env=env, **kwargs)
+
+
+def assert_every_drive_quick_stopped(blf_path: Path, silent_node: int | None = None) -> None:
+    """The CAN recording beside a log: every drive got the quick stop, and its last answer shows it
+    stopped (except the silent node's, a drive that no longer sends anything)."""
+    frames = list(can.LogReader(blf_path))
+    for node in NODE_IDS:
+        controlwords = [struct.unpack("<Hi", bytes(f.data))[0] for f in frames if f.arbitration_id == 0x200 + node]
+        statuswords = [struct.unpack("<Hih", bytes(f.data))[0] for f in frames if f.arbitration_id == 0x180 + node]
+        assert QUICK_STOP in controlwords, f"node {node}"
+        if node != silent_node:
+            assert state_from_statusword(statuswords[-1]) not in ENERGISED_STATES, f"node {node}"
 
 
 def read_until(fd, needle: bytes, timeout_s: float) -> bytes:

@@ -24,6 +24,7 @@ from tests.cli.cli_runner import crest, start_crest
 
 START_TIMEOUT_S = 300.0     # the first start in a fresh checkout compiles the plant's kernels
 STOP_TIMEOUT_S = 60.0
+GONE_TIMEOUT_S = 120.0      # a command's own testbed process ends this long after the command at most
 HEARTBEAT_TIMEOUT_S = 2.0
 RELAXED_TIMING = {         # [master] key: value
     "heartbeat_period_s": 0.2,
@@ -97,6 +98,14 @@ def stop(process: subprocess.Popen) -> None:
         except subprocess.TimeoutExpired:
             process.kill()
             process.wait()
+
+
+def wait_gone(pid: int, state_file: Path) -> None:
+    """Wait until the testbed process `pid` has ended and its state file is gone (fails after GONE_TIMEOUT_S)."""
+    deadline = time.monotonic() + GONE_TIMEOUT_S
+    while process_alive(pid) or state_file.exists():
+        assert time.monotonic() < deadline, f"testbed process {pid} or {state_file} outlived its command"
+        time.sleep(0.2)
 
 
 def rows_on_disk(log_path: Path) -> int:

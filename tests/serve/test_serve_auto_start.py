@@ -3,22 +3,13 @@ processes reach it while the command runs, and it ends with the command, kill -9
 CREST_VIRTUAL_TESTBED=in-process keeps it inside the command."""
 import json
 import subprocess
-import time
 
 from crest.exit_codes import ExitCode
-from served_testbed import (crest_lines, process_alive, relaxed_config, rows_on_disk, status_rows, stop,
-                            wait_for_rows)
+from served_testbed import (crest_lines, relaxed_config, rows_on_disk, status_rows, stop, wait_for_rows,
+                            wait_gone)
 from tests.cli.cli_runner import crest, start_crest
 
 AXES = ("tendon1", "tendon2", "tendon3", "tendon4", "insertion")
-GONE_TIMEOUT_S = 120.0
-
-
-def wait_gone(pid: int, state_file) -> None:
-    deadline = time.monotonic() + GONE_TIMEOUT_S
-    while process_alive(pid) or state_file.exists():
-        assert time.monotonic() < deadline, f"testbed process {pid} or {state_file} outlived its command"
-        time.sleep(0.2)
 
 
 def start_own_process_run(tmp_path):

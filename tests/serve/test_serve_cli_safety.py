@@ -10,22 +10,16 @@ Every test checks that the testbed process ended with its command.
 """
 import json
 import signal
-import struct
 import subprocess
-import time
 from pathlib import Path
 
-import can
 import pytest
 
-from crest.driver.cia402 import ENERGISED_STATES, QUICK_STOP, state_from_statusword
 from crest.exit_codes import ExitCode
 from crest.log import read_log
-from served_testbed import HEARTBEAT_TIMEOUT_S, crest_lines, process_alive, relaxed_config, stop, wait_for_rows
-from tests.cli.cli_runner import crest, start_crest
+from served_testbed import HEARTBEAT_TIMEOUT_S, crest_lines, relaxed_config, stop, wait_for_rows, wait_gone
+from tests.cli.cli_runner import assert_every_drive_quick_stopped, crest, start_crest
 
-NODE_IDS = (1, 2, 3, 4, 5)          # tendon1..tendon4, insertion
-GONE_TIMEOUT_S = 120.0
 DETECTION_S = 1.5                   # an EMCY or a following error reaches the master well within this
 # The fault clock starts just before the trajectory's first set-point, as in tests/cli's
 # test_fault_times_count_from_the_start_of_the_run; the log's time is the set-points' own.
@@ -34,25 +28,6 @@ CLOCK_LEAD_S = 0.1
 
 def state_file(runtime_dir: Path) -> Path:
     return runtime_dir / "crest" / "testbed.json"
-
-
-def wait_gone(pid: int, path) -> None:
-    deadline = time.monotonic() + GONE_TIMEOUT_S
-    while process_alive(pid) or path.exists():
-        assert time.monotonic() < deadline, f"testbed process {pid} or {path} outlived its command"
-        time.sleep(0.2)
-
-
-def assert_every_drive_quick_stopped(blf_path, silent_node: int | None = None) -> None:
-    """The CAN recording: every drive got the quick stop, and its last answer shows it stopped
-    (except the silent node's, a drive that no longer sends anything)."""
-    frames = list(can.LogReader(blf_path))
-    for node in NODE_IDS:
-        controlwords = [struct.unpack("<Hi", bytes(f.data))[0] for f in frames if f.arbitration_id == 0x200 + node]
-        statuswords = [struct.unpack("<Hih", bytes(f.data))[0] for f in frames if f.arbitration_id == 0x180 + node]
-        assert QUICK_STOP in controlwords, f"node {node}"
-        if node != silent_node:
-            assert state_from_statusword(statuswords[-1]) not in ENERGISED_STATES, f"node {node}"
 
 
 def sweep_with_fault(tmp_path: Path, fault: str, *options: str) -> tuple[subprocess.CompletedProcess, Path]:
