@@ -335,13 +335,14 @@ def _tip_tensions(u, compliance, dist_force, dist_short, slack, revived, tip_ten
 
 @kernel
 def _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_scale, friction, increment, tension,
-                       slack, f0, kx, gt, gth, bend_dir):
+                       slack, f0, kx, gt, gth, bend_dir, strength):
     """Exact Dahl forces of element i after the sliding `increment`, and their derivatives.
 
     Slack tendons get zeros. Fs = s_k*(Fsc + gain(theta)*T) with gain = 2 tanh(mu theta/2)
     (capstan_gain) and the rate-friction scale s_k of tendon k (fixed within the step, see
     run_path). Returns, per tendon, F0 = dahl_update(...), dF/dx, gt = dF/dFs * s*gain (own
-    tension), gth = dF/dFs * s*T*dgain/dtheta with dgain/dtheta = mu*(1 - tanh^2(mu theta/2)).
+    tension), gth = dF/dFs * s*T*dgain/dtheta with dgain/dtheta = mu*(1 - tanh^2(mu theta/2)),
+    and the strength Fs itself.
     """
     theta = math.sqrt(bx * bx + by * by)
     gain = capstan_gain(mu, theta)
@@ -358,10 +359,12 @@ def _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_scale, friction, i
             kx[k, i] = 0.0
             gt[k, i] = 0.0
             gth[k, i] = 0.0
+            strength[k, i] = 0.0
             continue
         s = rate_scale[k]
         t = max(tension[k, i], 0.0)
         fs = s * (fsc + gain * t)
+        strength[k, i] = fs
         force, d_dx, d_fs = dahl_update_with_slopes(friction[k, i], increment[k, i], fs, sigma, alpha)
         f0[k, i] = force
         kx[k, i] = d_dx
@@ -448,13 +451,14 @@ def make_workspace(n):
             np.empty((4, n)), np.empty((4, n)), np.empty((n, 4, 5)), np.empty(4), np.empty(4),
             np.empty((4, 5)), np.empty((4, 5)), np.empty((4, n)), np.empty((4, n)),
             np.empty((4, n)), np.empty((n, 2)), np.empty(n), np.empty((4, n)), np.empty(4),
-            np.zeros(4, dtype=np.bool_), np.empty(n), np.zeros((4, n), dtype=np.bool_), np.empty(4),
+            np.zeros(4, dtype=np.bool_), np.empty(n), np.zeros((4, n), dtype=np.bool_), np.zeros((4, n), dtype=np.bool_),
+            np.empty(4),
             np.zeros((4, n), dtype=np.bool_), np.zeros(4, dtype=np.bool_),
             (np.empty(4), np.empty(4), np.empty((4, 5)), np.empty((4, 5)), np.empty((4, 5)), np.empty(5), np.empty(4),
              np.empty(4)),
             (np.empty((4, 5)), np.zeros(4, dtype=np.bool_), np.zeros(4, dtype=np.bool_), np.empty((4, 4)),
              np.empty((4, 1)), np.empty(4, dtype=np.int64)),
-            np.empty((n, 2)), np.empty(4))
+            np.empty((n, 2)), np.empty(4), np.empty((4, n)))
 
 
 @kernel
@@ -486,8 +490,8 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
 
     (arm, angle, rest_bend, ext_bend, cos_phi, sin_phi, f0, kx, gt, gth, bend_dir, xref, tref, lin_force,
      distal_force, distal_short, dist_force, dist_short, new_force, new_sliding, new_tension,
-     new_bend, new_compression, increment, linear_force, revived, lengths, clamped, previous_increment,
-     crossed, slack_before, sweep_scratch, tip_scratch, dynamic_offset, u_step) = work
+     new_bend, new_compression, increment, linear_force, revived, lengths, clamped, released, previous_increment,
+     crossed, slack_before, sweep_scratch, tip_scratch, dynamic_offset, u_step, strength) = work
     compliance, carry = drive_creep(effects, dt_s)
     for k in range(4):
         u_step[k] = u[k] - carry * creep[k]
@@ -530,13 +534,14 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
             along1 += tref[k, i] * sin_phi[i, k]
         _linearise_element(i, rest_bend[i, 0] + offset[i, 0] + arm[i] / kb_step * along0,
                            rest_bend[i, 1] + offset[i, 1] + arm[i] / kb_step * along1, mu, fsc, sigma, alpha,
-                           rate_scale, friction, last_step, tref, slack, f0, kx, gt, gth, bend_dir)
+                           rate_scale, friction, last_step, tref, slack, f0, kx, gt, gth, bend_dir, strength)
         for k in range(4):
             xref[k, i] = sliding[k, i] + last_step[k, i]
 
     increment[:, :] = 0.0
     revived[:] = False
     clamped[:, :] = False
+    released[:, :] = False
     crossed[:, :] = False
     slack_before[:] = slack
     converged = False
@@ -598,33 +603,45 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
             for k in range(4):
                 previous_increment[k] = xref[k, i] - sliding[k, i]
             _linearise_element(i, bx, by, mu, fsc, sigma, alpha, rate_scale, friction, increment,
-                               new_tension, slack, f0, kx, gt, gth, bend_dir)
+                               new_tension, slack, f0, kx, gt, gth, bend_dir, strength)
             for k in range(4):
                 # Dahl has a kink at zero sliding (one-sided slopes differ up to 2 sigma). Where the
                 # iterate crossed it (once in this step), the chord from the step's start replaces
-                # the tangent, so Newton cannot jump back and forth across the kink.
+                # the tangent, so Newton cannot jump back and forth across the kink. The chord starts
+                # at the force of zero sliding, clip(F_prev, -Fs, Fs): where the tension fell, Fs
+                # clips the held force, and a chord from F_prev itself grew without bound as the
+                # iterate closed in on the kink (a 120 deg step: 6 mN never resolved).
                 if increment[k, i] * previous_increment[k] < 0.0:
                     crossed[k, i] = True
                 if crossed[k, i] and increment[k, i] != 0.0:
-                    kx[k, i] = max((f0[k, i] - friction[k, i]) / increment[k, i], 0.0)
+                    held = min(max(friction[k, i], -strength[k, i]), strength[k, i])
+                    kx[k, i] = max((f0[k, i] - held) / increment[k, i], 0.0)
                 # A tendon cannot be pushed: friction may at most unload the proximal half to zero,
                 # F >= -max(P, 0). Clamped at F = -P > 0 it is linear in the tension: K = 0, G = -2
                 # about the point (T_ref, F0) = (P/2, -P) of that line F = -2T (T = P + F/2); at
                 # F = 0 (P <= 0) it is constant. Once clamped, an element stays clamped for the
                 # step, so Newton cannot cycle on the kink.
+                # The exact law is F = max(F_dahl, -P): a clamp that the Dahl force no longer reaches
+                # (F_dahl > -P) is no equilibrium, and its mismatch counts, or a clamped element
+                # could hold any tension P (one recording: 92 N at the tip, 0 N at the drive).
                 distal_tension = tip_tension[k] + distal_force[k] - linear_force[k]
                 floor = -max(distal_tension, 0.0)
+                exact = f0[k, i]
                 xref[k, i] = new_sliding[k, i]
                 tref[k, i] = new_tension[k, i]
-                if not slack[k] and (f0[k, i] < floor or clamped[k, i]):
+                if clamped[k, i] and exact > floor + FORCE_TOLERANCE_N and not released[k, i]:
+                    clamped[k, i] = False      # released once per step, so Newton cannot cycle on it
+                    released[k, i] = True
+                elif not slack[k] and (f0[k, i] < floor or clamped[k, i]):
                     clamped[k, i] = True
+                    exact = max(exact, floor)
                     f0[k, i] = floor
                     kx[k, i] = 0.0
                     gt[k, i] = -2.0 if distal_tension > 0.0 else 0.0
                     gth[k, i] = 0.0
                     tref[k, i] = distal_tension + 0.5 * floor
                 new_force[k, i] = f0[k, i]
-                mismatch = abs(f0[k, i] - linear_force[k])
+                mismatch = abs(exact - linear_force[k])
                 if not math.isfinite(mismatch):
                     finite = False
                 worst = max(worst, mismatch)

@@ -45,16 +45,46 @@ def model_step(params: CatheterParams) -> dict:
 
 
 def dynamic_model_step(params: CatheterParams, damping_time_s: float = 0.02, inertia_scale: float = 1.0) -> dict:
-    """model_step in the dynamic mode (backward Euler, steps of at most 10 ms: one per 10 ms sample).
+    """model_step in the dynamic mode (backward Euler, steps of at most 10 ms: one per 10 ms sample),
+    with the default step's error on fast inputs (time_step_error).
 
     Unless the parameters already set them, a 20 ms damping time and the catheter's own mass.
     """
     if not params.dynamic:
         params = params.replace(damping_time_s=damping_time_s, inertia_scale=inertia_scale)
     result = model_step(params)
+    max_time_step_s = DahlCatheter(params, 20).max_time_step_s
     result.update(damping_time_s=params.damping_time_s, inertia_scale=params.inertia_scale,
-                  max_time_step_s=DahlCatheter(params, 20).max_time_step_s)
+                  max_time_step_s=max_time_step_s,
+                  time_step_rms_error_mm=time_step_error(params, (max_time_step_s,))[max_time_step_s])
     return result
+
+
+def fast_inputs(params: CatheterParams, duration_s: float = 4.0) -> dict[str, np.ndarray]:
+    """Two fast 100 Hz inputs [T, 4]: a 120 deg step at 0.5 s, and a two-tone multisine about 60 deg
+    pulling at up to 18 mm/s."""
+    t = np.arange(0.0, duration_s, 1.0 / SAMPLE_RATE_HZ)
+    angles_deg = {
+        "step_120_deg": np.where(t > 0.5, 120.0, 0.0),
+        "multisine": 60.0 * (1 + 0.6 * np.sin(2 * np.pi * 0.8 * t) + 0.3 * np.sin(2 * np.pi * 2.1 * t))
+        * (1 - np.exp(-t / 0.3))}
+    return {name: np.array([tendons_from_articulation(np.deg2rad(a), 0.0, params.tendon_offset_mm, 0.02)
+                            for a in angles]) for name, angles in angles_deg.items()}
+
+
+def time_step_error(params: CatheterParams, steps_s, reference_step_s: float = 0.0003125) -> dict:
+    """{step [s]: {input: tip RMS error [mm]}} of the dynamic model run with time steps of at most
+    step_s on the fast_inputs, against runs with steps of reference_step_s:
+
+        e = sqrt(mean_t |p_step(t) - p_ref(t)|^2)
+    """
+    errors: dict = {step_s: {} for step_s in steps_s}
+    for name, path in fast_inputs(params).items():
+        reference = DahlCatheter(params, max_time_step_s=reference_step_s).run(path)
+        for step_s in steps_s:
+            tips = DahlCatheter(params, max_time_step_s=step_s).run(path)
+            errors[step_s][name] = float(np.sqrt(np.mean(np.sum((tips - reference) ** 2, axis=1))))
+    return errors
 
 
 def scaling_in_n(params: CatheterParams, sizes=(10, 20, 40, 80, 160, 320)) -> dict:

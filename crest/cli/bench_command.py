@@ -87,6 +87,9 @@ def format_table(results: dict) -> str:
         rows.append((f"Dynamic model step, N=20 (backward Euler, <= {1e3 * r['max_time_step_s']:g} ms steps)",
                      f"{r['step_rate_hz']:.0f} steps/s, {r['real_time_factor']:.0f}x real time",
                      f">= {r['goal_real_time_factor']:.0f}x", r["real_time_factor"] >= r["goal_real_time_factor"]))
+        errors = ", ".join(f"{name} {e:.3f} mm" for name, e in r["time_step_rms_error_mm"].items())
+        rows.append((f"Dynamic model, {1e3 * r['max_time_step_s']:g} ms steps vs 0.3125 ms, tip RMS", errors,
+                     "< tracker noise", None))
     if "scaling" in results:
         r = results["scaling"]
         rows.append(("Cost exponent in N (10..320)", f"{r['cost_exponent']:.2f}", f"<= {r['goal_cost_exponent']}",

@@ -33,7 +33,15 @@ def test_calibration_recovers_known_parameters_from_noiseless_data():
     zeros = (0.002, -0.001, 0.0, 0.001)
     fit = calibrate_base([noiseless_recording(truth, zeros)], prior, resolution=RESOLUTION, max_iterations=40)
     assert fit.train_rmse_mm < 0.05          # from several mm at the prior
-    assert fit.params.bending_stiffness_nmm2 == pytest.approx(1150.0, rel=0.1)
+    # Tips alone fix the friction forces relative to the stiffness: scaling EI, EA, sigma and Fsc
+    # together changes them only through the tendon stiffness and the weight. So the ratios come
+    # back, not the scale (a solver change that only shortened Newton's path moved EI from 1107 to
+    # 1035 N*mm^2, both under 0.01 mm RMS with EI/sigma and EI/Fsc within 1%), and the statistics say
+    # so: EI and Fsc correlate strongly. A tension log would fix the scale.
+    p = fit.params
+    assert p.bending_stiffness_nmm2 / p.sigma_n_per_mm2 == pytest.approx(1150.0 / 0.7, rel=0.05)
+    assert p.bending_stiffness_nmm2 / p.fsc_n_per_mm == pytest.approx(1150.0 / 0.0065, rel=0.05)
+    assert fit.correlation[fit.names.index("bending_stiffness_nmm2")][fit.names.index("fsc_n_per_mm")] > 0.8
     assert fit.params.mu == pytest.approx(0.26, abs=0.03)
     assert fit.params.sigma_n_per_mm2 == pytest.approx(0.7, rel=0.3)
     assert fit.params.fsc_n_per_mm == pytest.approx(0.0065, rel=0.3)
