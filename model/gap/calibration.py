@@ -268,16 +268,19 @@ def calibrate_base(recordings: Sequence[Recording], prior: CatheterParams, *, re
                    max_iterations: int = 30, executor: Executor | None = None,
                    on_fit: Callable[[int, int], None] | None = None, fit_dynamics: bool = False) -> ModelFit:
     """The base model (no effects) fitted from each of `base_starts(prior)` and the GRID_STARTS best
-    points of `base_grid(prior)` (see module doc): the fit with the lowest training RMSE.
+    points of `base_grid(prior)` (see module doc), each distinct start once: the fit with the lowest
+    training RMSE.
 
     executor: runs the fits in parallel. on_fit(done, total) after each fit.
     fit_dynamics: also fit the damping time and inertia scale (for fast logs, see `is_fast`); the
     starts then begin at a 20 ms damping time and the catheter's own inertia, unless the prior has some.
     """
     prepared = resolution.prepare_training(recordings)
-    grid = [ModelFit(params, ZERO_OFFSETS_MM, {}) for params in base_grid(catheter_for(prior, prepared))]
+    measured = catheter_for(prior, prepared)     # the recordings' geometry, as `calibrate` gives every start
+    grid = [ModelFit(params, ZERO_OFFSETS_MM, {}) for params in base_grid(measured)]
     costs = probe_costs(grid, prepared, resolution)
-    starts = base_starts(prior) + [grid[i].params for i in np.argsort(costs, kind="stable")[:GRID_STARTS]]
+    starts = base_starts(measured) + [grid[i].params for i in np.argsort(costs, kind="stable")[:GRID_STARTS]]
+    starts = [start for i, start in enumerate(starts) if start not in starts[:i]]   # the grid holds the prior
     if fit_dynamics and not prior.dynamic:
         starts = [start.replace(damping_time_s=DYNAMIC_START[0], inertia_scale=DYNAMIC_START[1]) for start in starts]
     fit_from = partial(calibrate, recordings, prior=prior, resolution=resolution, max_iterations=max_iterations,

@@ -7,11 +7,12 @@ log flush) must have run once with the stop.
 """
 
 import math
+import time
 
 import can
 import pytest
 
-from crest.driver import SafetyStop, SdoFailure, emergency_stop
+from crest.driver import SafetyStop, SdoFailure, cia402, emergency_stop
 from crest.driver.cia402 import Cia402State
 from crest.exit_codes import ExitCode
 from driver_rig import STOPPED_STATES, is_sync, make_config, rpdo1, tpdo1
@@ -227,6 +228,29 @@ def test_emergency_stop_tries_every_axis_and_reports_the_one_it_could_not_reach(
     with pytest.raises(SafetyStop) as stop:        # closing needs tendon3's SDO server too
         rig.testbed.close()
     assert (stop.value.exit_code, stop.value.axis) == (ExitCode.SDO_FAILURE, "tendon3")
+
+
+def test_a_drive_that_does_not_answer_delays_no_other_axis_quick_stop(make_rig):
+    """The quick stops go out at once: with tendon1, the first axis, silent for its whole 5 s SDO
+    timeout, every other axis' quick stop is on the bus before that timeout ends and each is stopped."""
+    rig = make_rig(config=make_config(sdo_timeout_s=5.0))   # the timeout is expected to expire
+    rig.testbed.boot()
+    rig.drive("tendon1").inject_fault(FaultKind.SDO_TIMEOUT)
+    other_bus = can.Bus(interface="virtual", channel=rig.channel)
+    start_s = time.time()
+    try:
+        outcome = emergency_stop(other_bus, rig.config)
+    finally:
+        other_bus.shutdown()
+    quick_stop = bytes([0x2B, 0x40, 0x60, 0x00, cia402.QUICK_STOP, 0x00])   # SDO download 0x6040:00 = 2
+    sent_s = {f.arbitration_id - 0x600: f.timestamp for f in rig.frames()
+              if 0x600 < f.arbitration_id < 0x680 and bytes(f.data[:6]) == quick_stop and f.timestamp >= start_s}
+    assert isinstance(outcome.pop("tendon1"), SdoFailure)
+    for name, state in outcome.items():
+        assert state in {Cia402State.QUICK_STOP_ACTIVE, Cia402State.SWITCH_ON_DISABLED}, name
+        assert sent_s[rig.config.axis(name).node_id] < start_s + 5.0, name
+    with pytest.raises(SafetyStop):        # closing needs tendon1's SDO server too
+        rig.testbed.close()
 
 
 def test_a_dead_host_stops_the_testbed(homed):
