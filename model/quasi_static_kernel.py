@@ -617,13 +617,13 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
                     held = min(max(friction[k, i], -strength[k, i]), strength[k, i])
                     kx[k, i] = max((f0[k, i] - held) / increment[k, i], 0.0)
                 # A tendon cannot be pushed: friction may at most unload the proximal half to zero,
-                # F >= -max(P, 0). Clamped at F = -P > 0 it is linear in the tension: K = 0, G = -2
-                # about the point (T_ref, F0) = (P/2, -P) of that line F = -2T (T = P + F/2); at
-                # F = 0 (P <= 0) it is constant. Once clamped, an element stays clamped for the
-                # step, so Newton cannot cycle on the kink.
-                # The exact law is F = max(F_dahl, -P): a clamp that the Dahl force no longer reaches
-                # (F_dahl > -P) is no equilibrium, and its mismatch counts, or a clamped element
-                # could hold any tension P (one recording: 92 N at the tip, 0 N at the drive).
+                # so the exact law is F = max(F_dahl, -max(P, 0)). Clamped at F = -P > 0 it is linear
+                # in the tension: K = 0, G = -2 about the point (T_ref, F0) = (P/2, -P) of that line
+                # F = -2T (T = P + F/2); at F = 0 (P <= 0) it is constant. A clamped element stays
+                # clamped for the step, so Newton cannot cycle on the kink, but is released once where
+                # the Dahl force no longer reaches the floor (F_dahl > -P): that clamp is no
+                # equilibrium, so its mismatch to the Dahl force counts; kept, a clamped element could
+                # hold any tension P (one recording: 92 N at the tip, 0 N at the drive).
                 distal_tension = tip_tension[k] + distal_force[k] - linear_force[k]
                 floor = -max(distal_tension, 0.0)
                 exact = f0[k, i]
