@@ -36,8 +36,9 @@ def emergency_stop(bus: can.BusABC, config: TestbedConfig) -> dict[str, Cia402St
     network.NOTIFIER_CYCLE = RECEIVE_POLL_S
     network.connect()
     try:
-        channels = {name: AxisSdo(name, network.add_node(config.axis(name).node_id, str(config.axis(name).eds_path)),
-                                  config.master.sdo_timeout_s) for name in AXIS_ORDER}
+        axes = [config.axis(name) for name in AXIS_ORDER]
+        channels = {axis.name: AxisSdo(axis.name, network.add_node(axis.node_id, str(axis.eds_path)),
+                                       config.master.sdo_timeout_s) for axis in axes}
         with ThreadPoolExecutor(max_workers=len(channels), thread_name_prefix="crest-estop") as pool:
             outcomes = pool.map(_quick_stop, channels.values())
             return dict(zip(channels, outcomes))
