@@ -23,7 +23,8 @@ class CandidateEffect:
     wanted more than the effect can physically be, and is implausible.
     signature: the residual pattern it leaves when it is missing from a model.
     signature_region: where in the motion adding it must remove error (a region the gap
-    diagnosis knows, see model.gap.plausibility), "" where the signature names no such region.
+    diagnosis knows, see model.gap.plausibility; "every region": it removes error everywhere), ""
+    where the signature names no such region.
     apply: (terms, values) -> terms with this effect's fields set.
     """
 

@@ -58,8 +58,8 @@ EFFECTS: dict[str, CandidateEffect] = {e.id: e for e in (
         physics="a rigid registration error of the tip sensor: a constant offset of the measured tip",
         param_names=("dx_mm", "dy_mm", "dz_mm"), typical=(1.0, -0.8, 0.6),
         lower=(-10.0, -10.0, -10.0), upper=(10.0, 10.0, 10.0),
-        signature="a constant bias everywhere, including static holds at zero load",
-        signature_region="zero load",
+        signature="a constant bias everywhere: adding it removes error in every region of the motion",
+        signature_region="every region",
         apply=lambda t, v: t.replace(tracker_offset_mm=(v[0], v[1], v[2]))),
     CandidateEffect(
         id="rate_friction",

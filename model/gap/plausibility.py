@@ -17,6 +17,12 @@ Two checks, each giving a reason when it fails (a fit that passes both has no re
    gravity fit that improves only the strongly bent samples, not the straight ones where sag
    is present at zero load) does not explain the residual the way its physics would. A region
    with fewer than MIN_REGION_SAMPLES samples cannot tell and passes.
+   An effect whose signature is everywhere (EVERY_REGION: a constant bias) must remove error in
+   each region, min_R C_R > 0, but need not concentrate in any: the baseline's tendon zeros
+   absorb part of a constant tip offset at zero load (a slight bend under a little pretension)
+   and none of it where the catheter is bent, so a true offset's gain lies mostly at high
+   articulation (0.09-0.36 of its share at zero load on three logs with a true offset, which
+   the zero-load rule rejected). A fit that makes any region worse absorbs something else.
 
 The signature regions (the catalog's `signature_region`):
     zero load          articulation < ZERO_LOAD_DEG
@@ -24,6 +30,7 @@ The signature regions (the catalog's `signature_region`):
     high tension       total tendon tension at or above its median
     after reversal     the motion class "after reversal"
     fast               moving with the fastest tendon at FAST_MM_S or more
+    every region       each of the above in turn (EVERY_REGION)
 """
 from __future__ import annotations
 
@@ -38,12 +45,20 @@ ZERO_LOAD_DEG = 15.0
 HIGH_ARTICULATION_DEG = 45.0
 FAST_MM_S = 2.0
 NEAR_BASE_FRACTION = 0.5
+EVERY_REGION = "every region"
 
 
 def signature_region(name: str, features: SampleFeatures) -> np.ndarray:
     """The mask of a signature region (see module doc) over the samples of `features`."""
-    f = features
-    masks = {
+    masks = _region_masks(features)
+    if name not in masks:
+        raise ValueError(f"unknown signature region {name!r}; known: {', '.join(masks)}, {EVERY_REGION}")
+    return masks[name]()
+
+
+def _region_masks(f: SampleFeatures) -> dict:
+    """{region name: a function giving its mask}, for the located regions (see module doc)."""
+    return {
         "zero load": lambda: f.articulation_deg < ZERO_LOAD_DEG,
         "high articulation": lambda: f.articulation_deg >= HIGH_ARTICULATION_DEG,
         "high tension": lambda: f.tension_n >= np.median(f.tension_n),
@@ -51,9 +66,6 @@ def signature_region(name: str, features: SampleFeatures) -> np.ndarray:
         "fast": lambda: np.isin(f.motion, ("loading", "unloading", "after reversal", "sideways"))
         & (f.speed_mm_s >= FAST_MM_S),
     }
-    if name not in masks:
-        raise ValueError(f"unknown signature region {name!r}; known: {', '.join(masks)}")
-    return masks[name]()
 
 
 def range_reasons(effect_id: str, values: tuple[float, ...], flexible_length_mm: float | None = None) -> list[str]:
@@ -77,23 +89,38 @@ def range_reasons(effect_id: str, values: tuple[float, ...], flexible_length_mm:
 
 def signature_concentration(effect_id: str, features: SampleFeatures, before_mm: np.ndarray,
                             after_mm: np.ndarray) -> tuple[float | None, str]:
-    """C_R of the effect's gain (see module doc) and its region's name; None where it cannot tell
-    (no region, too few samples in it, or no gain at all)."""
+    """C_R of the effect's gain (see module doc) and its region's name; for EVERY_REGION the smallest
+    C_R over the regions and that region's name. None where it cannot tell (no region, too few
+    samples in it, or no gain at all)."""
     region_name = effect(effect_id).signature_region
     if not region_name:
         return None, ""
-    region = signature_region(region_name, features)
     gain = np.sum(np.asarray(before_mm) ** 2, axis=1) - np.sum(np.asarray(after_mm) ** 2, axis=1)
     total = float(gain.sum())
-    if region.sum() < MIN_REGION_SAMPLES or not np.isfinite(total) or total <= 0.0:
+    if not np.isfinite(total) or total <= 0.0:
         return None, region_name
-    return float(gain[region].sum() / total / region.mean()), region_name
+    names = list(_region_masks(features)) if region_name == EVERY_REGION else [region_name]
+    concentrations = {}
+    for name in names:
+        region = signature_region(name, features)
+        if region.sum() >= MIN_REGION_SAMPLES:
+            concentrations[name] = float(gain[region].sum() / total / region.mean())
+    if not concentrations:
+        return None, region_name
+    weakest = min(concentrations, key=concentrations.get)
+    return concentrations[weakest], weakest
 
 
 def signature_reasons(effect_id: str, features: SampleFeatures, before_mm: np.ndarray,
                       after_mm: np.ndarray) -> tuple[list[str], float | None]:
-    """Why the effect's improvement does not sit where its signature says (empty: it does), and C_R."""
+    """Why the effect's improvement does not sit where its signature says (empty: it does), and C_R
+    (for EVERY_REGION: the smallest)."""
     concentration, region_name = signature_concentration(effect_id, features, before_mm, after_mm)
+    if effect(effect_id).signature_region == EVERY_REGION:
+        if concentration is None or concentration > 0.0:
+            return [], concentration
+        return [f"{effect_id} makes the fit worse in one region ({region_name}: concentration {concentration:.2f} "
+                f"<= 0), where its signature removes error everywhere ({effect(effect_id).signature})"], concentration
     if concentration is None or concentration >= MIN_SIGNATURE_CONCENTRATION:
         return [], concentration
     return [f"{effect_id} removes error mostly outside its signature region ({region_name}): concentration "
