@@ -6,11 +6,16 @@ This is the one place in crest that may import sim_backend. Everything above it 
 The virtual testbed ([bus] interface = "virtual") is found in one of two places. When a served
 one runs (`crest testbed serve`, its own process; see crest.testbed_service), the commands join it
 through python-can's "remote" interface on the channel its state file names, as they would join a
-hardware bus. Otherwise a real-time command starts a served testbed process of its own, which ends
-with it (crest.testbed_service.auto_start), and joins that. A command boots the virtual testbed
-inside its own process, on python-can's in-process bus, in simulated time (`--fast`, tests), with
-CREST_VIRTUAL_TESTBED=in-process, or where what it sets up cannot be handed to another process (a
-configuration changed in memory, the tracker's noise and dropout overridden).
+hardware bus. Otherwise a command starts a served testbed process of its own, which ends with it
+(crest.testbed_service.auto_start), and joins that. A command in simulated time (`--fast`, most
+tests) gets one in simulated time: its stepped clock sends a CANopen TIME stamp on the bus each
+time it moves, and the testbed process moves its drives to that time (sim_backend.time_stamps);
+a served testbed in real time is no use to it. A command boots the virtual testbed inside its own
+process instead, on python-can's in-process bus, with CREST_VIRTUAL_TESTBED=in-process, when its
+caller asks (`in_process`: tests that reach into the simulator, the blind benchmark's recordings),
+when a served testbed in the other kind of time runs (`--fast` beside a real-time one), or where
+what it sets up cannot be handed to another process (a configuration changed in memory, the
+tracker's noise and dropout overridden).
 """
 from __future__ import annotations
 
@@ -27,9 +32,11 @@ from crest.config.testbed_config import AxisConfig
 from crest.testbed_service import ServedTestbed, config_digest, running_testbed
 from crest.testbed_service.auto_start import MODE_VARIABLE, OwnedTestbed, start_owned_testbed, wants_own_process
 from crest.testbed_service.served_bus import ServedBus
+from sim_backend.time_stamps import StampAnswers, time_stamp_frame
 
 _channel_numbers = itertools.count(1)
 INSERTION_START_ABOVE_HOME_MM = 2.0   # the simulated pulley block powers up this far from its switch
+STAMP_ANSWER_TIMEOUT_S = 10.0   # wall time a testbed in simulated time may take to answer a TIME stamp
 
 
 class BackendError(ValueError):
@@ -45,6 +52,7 @@ class Backend:
     virtual: object | None = None   # sim_backend.VirtualTestbed when simulated in this process
     served: ServedTestbed | None = None   # the served virtual testbed this process joined
     owned: OwnedTestbed | None = None     # ... when this process started it for itself
+    stamp_answers: StampAnswers | None = None   # ... when it runs in simulated time
 
     @property
     def is_virtual(self) -> bool:
@@ -67,9 +75,15 @@ class Backend:
             self.owned.start_fault_clock()
 
     def tick(self, now_s: float) -> None:
-        """Advance the simulator's time-based duties (deterministic use); no-op on hardware."""
+        """Advance the simulator's time-based duties (simulated time): the testbed in this process,
+        or a served one in simulated time through a TIME stamp on the bus, once the previous stamp
+        is answered (sim_backend.time_stamps); no-op on hardware."""
         if self.virtual is not None:
             self.virtual.tick(now_s)
+        elif self.stamp_answers is not None:
+            self.stamp_answers.wait_for_last(STAMP_ANSWER_TIMEOUT_S, gone=lambda: self.bus.lost is not None)
+            self.bus.send(time_stamp_frame(now_s))
+            self.stamp_answers.sent(now_s)
 
     def close(self) -> None:
         self.bus.shutdown()
@@ -89,13 +103,15 @@ def fault_kinds() -> dict[str, tuple[str, ...]]:
 
 def open_backend(config: TestbedConfig, *, plant: str | None = None, plant_config: Path | None = None,
                  faults: Sequence[str] = (), effects: dict | None = None, realtime: bool = True,
-                 tracker_noise_mm: float | None = None, tracker_dropout: float | None = None) -> Backend:
+                 in_process: bool = False, tracker_noise_mm: float | None = None,
+                 tracker_dropout: float | None = None) -> Backend:
     """Open the bus and tracker of `config`.
 
     plant ('package.module:ClassName'), plant_config (the plant description, default
     configs/virtual_plant.toml; its `family` picks the Dahl or the rod plant), faults ('AXIS:KIND@SECONDS'), effects ({effect id: {param: value}},
     added to the plant description's) and the tracker's noise and dropout apply to the virtual
-    testbed only. realtime=False leaves time to the caller's `Backend.tick` (tests).
+    testbed only. realtime=False leaves time to the caller's `Backend.tick` (simulated time: `--fast`, tests).
+    in_process: the virtual testbed boots inside this process (see crest.session.SessionOptions).
     """
     if config.bus.interface != "virtual":
         if (plant or plant_config or faults or effects or tracker_noise_mm is not None
@@ -106,36 +122,55 @@ def open_backend(config: TestbedConfig, *, plant: str | None = None, plant_confi
             raise BackendError(f"{config.path}: [tracker].port = 'sim' needs the virtual testbed; "
                                "set it to the tracker's serial device")
         return Backend(bus=_open_hardware_bus(config), tracker_port=config.tracker.port)
-    served = running_testbed() if realtime else None
-    if served is not None:
+    if in_process:
+        return _open_virtual(config, plant, plant_config, faults, effects or {}, realtime, tracker_noise_mm,
+                             tracker_dropout)
+    served = running_testbed()
+    if served is not None and realtime and served.simulated_time:
+        raise BackendError(f"the served virtual testbed ({served.describe()}) moves only with the simulated time of a "
+                           "command run with --fast; add --fast, or stop it and serve one in real time")
+    if served is not None and served.simulated_time != realtime:
         if plant or plant_config or faults or effects or tracker_noise_mm is not None or tracker_dropout is not None:
             raise BackendError("--plant, --plant-config, --fault, --effect and the tracker's noise and dropout "
                                f"set up a virtual testbed when it starts, but a served one is running ({served.describe()}); "
                                "stop it, or pass them to `crest testbed serve`, or drop them")
-        return Backend(bus=_join_served(config, served), tracker_port=served.tracker_port, served=served)
+        return _joined(config, served)
     # a testbed process is given the configuration's file, the plant and the faults; a configuration
-    # changed in memory (not its file's values) and the tracker overrides stay in this process
-    if (realtime and wants_own_process() and tracker_noise_mm is None and tracker_dropout is None
+    # changed in memory (not its file's values) and the tracker overrides stay in this process, and
+    # beside a served testbed in real time (one server per user) a command in simulated time keeps its own
+    if (served is None and wants_own_process() and tracker_noise_mm is None and tracker_dropout is None
             and config_digest(load_testbed_config(config.path)) == config_digest(config)):
-        return _open_owned(config, plant, plant_config, effects or {}, faults)
+        return _open_owned(config, plant, plant_config, effects or {}, faults, simulated_time=not realtime)
     return _open_virtual(config, plant, plant_config, faults, effects or {}, realtime, tracker_noise_mm,
                          tracker_dropout)
 
 
 def _open_owned(config: TestbedConfig, plant: str | None, plant_config: Path | None, effects: dict,
-                faults: Sequence[str]) -> Backend:
+                faults: Sequence[str], simulated_time: bool) -> Backend:
     """A served testbed process of this command's own, joined (it ends when this process does).
     The faults are checked here, before the process starts, as the testbed checks them."""
     from sim_backend.faults import check_fault_axes, parse_fault
 
     check_fault_axes([parse_fault(text) for text in faults], [axis.name for axis in config.axes])
-    owned = start_owned_testbed(config.path, plant, plant_config, effects, faults)
+    owned = start_owned_testbed(config.path, plant, plant_config, effects, faults, simulated_time)
     try:
-        bus = _join_served(config, owned.served)
+        backend = _joined(config, owned.served)
     except BackendError:
         owned.stop()
         raise
-    return Backend(bus=bus, tracker_port=owned.served.tracker_port, served=owned.served, owned=owned)
+    backend.owned = owned
+    return backend
+
+
+def _joined(config: TestbedConfig, served: ServedTestbed) -> Backend:
+    """The backend of a served testbed, joined; in simulated time its bus hands every frame to the
+    answers of the TIME stamps (sim_backend.time_stamps)."""
+    bus = _join_served(config, served)
+    backend = Backend(bus=bus, tracker_port=served.tracker_port, served=served)
+    if served.simulated_time:
+        backend.stamp_answers = StampAnswers()
+        bus.receive_hooks.append(backend.stamp_answers.on_frame)
+    return backend
 
 
 def join_bus(config: TestbedConfig) -> can.BusABC:
@@ -150,9 +185,10 @@ def join_bus(config: TestbedConfig) -> can.BusABC:
     served = running_testbed()
     if served is None:
         raise BackendError(f"no virtual testbed is running ({config.path}: [bus] interface = 'virtual'): no crest "
-                           "command has started one, and none is served (`crest testbed serve`). A command in simulated "
-                           f"time (--fast) or run with {MODE_VARIABLE}=in-process keeps its testbed inside its own "
-                           "process, where no other process can reach it: stop that run with Ctrl-C (or SIGTERM)")
+                           "command has started one, and none is served (`crest testbed serve`). A command run with "
+                           f"{MODE_VARIABLE}=in-process (or with --fast beside a testbed served in real time) keeps its "
+                           "testbed inside its own process, where no other process can reach it: stop that run with "
+                           "Ctrl-C (or SIGTERM)")
     return _join_served(config, served)
 
 
@@ -206,9 +242,10 @@ class VirtualTestbedServer:
 
 def serve_virtual_testbed(config: TestbedConfig, *, plant: str | None = None, plant_config: Path | None = None,
                           effects: dict | None = None, faults: Sequence[str] = (), faults_wait_for_run: bool = False,
-                          port: int = 0) -> VirtualTestbedServer:
-    """Start the virtual testbed of `config` (real time) and serve its CAN bus on 127.0.0.1:port
-    (0: any free port) over python-can-remote. plant, plant_config, effects and faults as for
+                          port: int = 0, simulated_time: bool = False) -> VirtualTestbedServer:
+    """Start the virtual testbed of `config` and serve its CAN bus on 127.0.0.1:port (0: any free
+    port) over python-can-remote. Its clock: real time, or with simulated_time the TIME stamps on
+    the bus (sim_backend.time_stamps). plant, plant_config, effects and faults as for
     `open_backend`; the faults' clock starts now, or with faults_wait_for_run at the testbed's
     `start_fault_clock`."""
     from sim_backend.bus_server import BusServer
@@ -219,7 +256,7 @@ def serve_virtual_testbed(config: TestbedConfig, *, plant: str | None = None, pl
     channel = f"{config.bus.channel}-served-{os.getpid()}"
     testbed = _virtual_testbed(config, channel, plant, plant_config, faults, effects or {}, faults_wait_for_run,
                                None, None)
-    testbed.start(realtime=True)
+    testbed.start(realtime=not simulated_time, time_stamps=simulated_time)
     try:
         server = BusServer(channel, port).start()
     except OSError as exc:

@@ -41,7 +41,10 @@ class Session:
 class SessionOptions:
     """What to open. plant/plant_config/faults/effects/tracker_* apply to the virtual testbed only.
 
-    realtime=False runs the virtual testbed in simulated time (deterministic tests).
+    realtime=False runs the virtual testbed in simulated time (deterministic tests). in_process boots
+    the virtual testbed inside this process, on python-can's in-process bus, instead of in a process
+    of its own (crest.backend): for callers that reach into the simulator (`backend.virtual`, tests)
+    and for data generators that record many logs, where the second process costs CPU.
     """
 
     config_path: Path | None = None
@@ -51,6 +54,7 @@ class SessionOptions:
     faults: Sequence[str] = ()
     effects: dict | None = None
     realtime: bool = True
+    in_process: bool = False
     boot: bool = True
     tracker: bool = True
     tracker_rate_hz: float = TRACKER_RATE_HZ
@@ -63,7 +67,8 @@ def open_session(options: SessionOptions = SessionOptions()) -> Iterator[Session
     config = options.config if options.config is not None else load_testbed_config(options.config_path)
     backend = open_backend(config, plant=options.plant, plant_config=options.plant_config, faults=options.faults,
                            effects=options.effects,
-                           realtime=options.realtime, tracker_noise_mm=options.tracker_noise_mm,
+                           realtime=options.realtime, in_process=options.in_process,
+                           tracker_noise_mm=options.tracker_noise_mm,
                            tracker_dropout=options.tracker_dropout)
     with ExitStack() as stack:
         stack.callback(backend.close)

@@ -60,6 +60,15 @@ class SimDriveSet:
         SYNC frame, after every drive has run its cycle for it."""
         self._sync_listeners.append(listener)
 
+    def subscribe(self, cob_id: int, callback: Callable[[int, bytearray, float], None]) -> None:
+        """Call ``callback(can_id, data, timestamp)`` for each frame with this COB-ID, in the drives'
+        receive thread (so in order with the frames the drives handle); after ``start``."""
+        self._network.subscribe(cob_id, callback)
+
+    def send(self, msg: can.Message) -> None:
+        """Send a frame on the drives' bus (from any thread); after ``start``."""
+        self._network.send_message(msg.arbitration_id, msg.data)
+
     def _on_sync(self, can_id: int, data: bytearray, timestamp: float) -> None:
         for listener in self._sync_listeners:
             listener(can_id, data, timestamp)

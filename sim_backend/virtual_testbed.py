@@ -9,11 +9,13 @@ drives, which report them as torque actual (0x6077) from the next cycle. A plant
 the bus runs in its own thread instead, and the drives use its latest output.
 
 Time: the drives' motion advances by SYNC frames. Time-based duties (heartbeats, watchdogs,
-scheduled faults) advance with `tick(now_s)`: called by the tests with simulated time, or by
-a real-time thread when `start(realtime=True)`.
+scheduled faults) advance with `tick(now_s)`: called by the tests with simulated time, by a
+real-time thread when `start(realtime=True)`, or by the TIME stamps a master in another process
+sends on the bus when `start(time_stamps=True)` (sim_backend.time_stamps).
 """
 from __future__ import annotations
 
+import sys
 import threading
 import time
 from collections.abc import Sequence
@@ -23,6 +25,7 @@ from sim_backend.drive.drive_spec import DriveSpec
 from sim_backend.drives import SimDriveSet
 from sim_backend.faults import FaultSchedule, FaultSpec
 from sim_backend.plant import Plant, PlantError, PlantRunner
+from sim_backend.time_stamps import TIME_COB_ID, time_ack_frame, time_stamp_seconds
 from sim_backend.tracker import SimTracker
 
 TENDON_AXES = ("tendon1", "tendon2", "tendon3", "tendon4")
@@ -62,9 +65,16 @@ class VirtualTestbed:
         self._now_s = 0.0          # the last tick's time (s since start)
 
     # -- life cycle ---------------------------------------------------------------------------
-    def start(self, realtime: bool = False) -> "VirtualTestbed":
+    def start(self, realtime: bool = False, time_stamps: bool = False) -> "VirtualTestbed":
+        """Start the drives, the plant and the tracker. Time: realtime, a thread ticks the testbed on
+        the wall clock; time_stamps, every TIME stamp on the bus moves it (sim_backend.time_stamps);
+        neither, the caller ticks it."""
+        if realtime and time_stamps:
+            raise ValueError("a virtual testbed keeps one clock: real time or the bus's TIME stamps, not both")
         self.drives.start()
         self.drives.add_sync_listener(self._on_sync)
+        if time_stamps:
+            self.drives.subscribe(TIME_COB_ID, self._on_time_stamp)
         self.tracker.start()
         if self.plant_in_thread:
             self.plant_runner.start_thread()
@@ -108,6 +118,15 @@ class VirtualTestbed:
         self.drives.tick(now_s)
         for fault in self._tracker_faults.due(now_s):
             self.tracker.inject(fault.kind.value)
+
+    def _on_time_stamp(self, can_id: int, data: bytearray, timestamp: float) -> None:
+        try:
+            now_s = time_stamp_seconds(data)
+        except ValueError as exc:       # a frame some other node sent with this COB-ID
+            print(f"virtual testbed: TIME stamp ignored: {exc}", file=sys.stderr, flush=True)
+            return
+        self.tick(now_s)
+        self.drives.send(time_ack_frame(data))
 
     def _tick_in_real_time(self) -> None:
         while not self._stop.wait(REALTIME_TICK_S):

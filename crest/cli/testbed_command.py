@@ -36,6 +36,9 @@ def add_parser(sub) -> None:
                             "testbed's start (from the start of the command's motion for a testbed a command started)")
     serve.add_argument("--port", type=_tcp_port, default=0,
                        help="TCP port of the CAN bus server on 127.0.0.1 (default 0: any free port)")
+    serve.add_argument("--simulated-time", action="store_true",
+                       help="move the testbed's clock only with the CANopen TIME stamps its master sends (a command "
+                            "run with --fast), not with the wall clock: deterministic runs as fast as the computer allows")
     serve.add_argument("--parent-fd", type=int, default=None, help=argparse.SUPPRESS)   # auto_start.py's pipe
     add_debug_option(serve)
     parser.set_defaults(handler=run)
@@ -57,7 +60,8 @@ def run(args: argparse.Namespace) -> int:
     effects = dict(parse_effect(text) for text in args.effect)
     try:
         serve_until_stopped(config, plant=args.plant, plant_config=args.plant_config, effects=effects,
-                            faults=args.fault, port=args.port, on_ready=_announce, parent_fd=args.parent_fd)
+                            faults=args.fault, port=args.port, on_ready=_announce, parent_fd=args.parent_fd,
+                            simulated_time=args.simulated_time)
     except TestbedAlreadyServed as exc:
         print(f"crest testbed serve: {exc}", file=sys.stderr)
         return int(ExitCode.ERROR)
@@ -73,5 +77,7 @@ def _announce(served, state_file: Path) -> None:
           f"  CAN bus:    python-can interface '{served.bus_interface}', channel '{served.bus_channel}'\n"
           f"  tracker:    {served.tracker_port}\n"
           f"  state file: {state_file}\n"
-          "Other crest commands on this configuration join it now. Stop it with Ctrl-C "
+          + ("  clock:      simulated: it moves only with the TIME stamps of a command run with --fast\n"
+             if served.simulated_time else "")
+          + "Other crest commands on this configuration join it now. Stop it with Ctrl-C "
           f"(or kill -TERM {served.pid}).", flush=True)

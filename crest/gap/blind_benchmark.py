@@ -240,7 +240,7 @@ def record_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Exci
         if redraw:
             case = _redrawn(case, redraw, prior)
         options = SessionOptions(config=config, plant_config=write_plant_config(case, folder / f"plant_{redraw}"),
-                                 realtime=False)
+                                 realtime=False, in_process=True)
         try:
             results = call_isolated(_record, options, plan, folder / f"logs_{redraw}", prior,
                                     timeout_s=RECORD_TIMEOUT_S, cancel=cancel)
@@ -251,7 +251,7 @@ def record_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Exci
             continue
         reference = None
         if case.family == "rod" and case.effects:
-            plain = SessionOptions(config=config, realtime=False,
+            plain = SessionOptions(config=config, realtime=False, in_process=True,
                                    plant_config=write_plant_config(case, folder / f"plant_{redraw}_plain", False))
             held_only = ExcitationPlan(plan.conditioning, {"holdout": plan.logs["holdout"]})
             try:

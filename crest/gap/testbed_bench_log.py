@@ -78,7 +78,8 @@ def testbed_logs(seed: int = 0, duration_s: float = 600.0) -> BenchLogs:
                                                   "holdout": standard.logs["holdout"]})
     plant, noise_mm, dropout = draw_plant(prior, np.random.default_rng(seed))
     case = BlindCase(0, "single", plant, noise_mm, dropout, seed)
-    options = SessionOptions(config=config, plant_config=write_plant_config(case, folder / "plant"), realtime=False)
+    options = SessionOptions(config=config, plant_config=write_plant_config(case, folder / "plant"), realtime=False,
+                             in_process=True)
     results = call_isolated(_record, options, plan, folder / "logs", prior, timeout_s=RECORD_TIMEOUT_S)
     description = {"effects": {k: list(v) for k, v in plant.effects.items()},
                    "parameter_factors": {name: getattr(plant.params, name) / getattr(prior, name)

@@ -1,7 +1,7 @@
 """A served virtual testbed started for one command and stopped with it.
 
-A real-time command that finds no served testbed starts `crest testbed serve` as its child, joins
-it like any served testbed (so `crest estop` and `crest status` reach it from other processes),
+A command that finds no served testbed starts `crest testbed serve` as its child (with
+`--simulated-time` for a command in simulated time, `--fast`), joins it like any served testbed (so `crest estop` and `crest status` reach it from other processes),
 and stops it when the command ends. The child holds the read end of a pipe whose only writer is
 the command: when the command ends, however it ends (a crash, kill -9), the kernel closes the
 pipe and the child stops itself (serve.py). The same pipe carries the command's one message to
@@ -69,15 +69,17 @@ class OwnedTestbed:
 
 
 def start_owned_testbed(config_path: Path, plant: str | None, plant_config: Path | None, effects: dict,
-                        faults: Sequence[str]) -> OwnedTestbed:
+                        faults: Sequence[str], simulated_time: bool = False) -> OwnedTestbed:
     """`crest testbed serve` as a child of this process, returned once it serves (AutoStartError if
     it cannot start, e.g. because another testbed took the lock in the meantime). plant, plant_config,
     effects and faults as for `crest.backend.open_backend`; the faults' clock starts with
-    `OwnedTestbed.start_fault_clock`."""
+    `OwnedTestbed.start_fault_clock`. simulated_time: its clock moves with this command's TIME stamps."""
     read_fd, write_fd = os.pipe()
     os.set_inheritable(read_fd, True)
     command = [sys.executable, "-m", "crest.cli.main", "testbed", "serve", "--config", str(config_path),
                "--parent-fd", str(read_fd)]
+    if simulated_time:
+        command += ["--simulated-time"]
     if plant is not None:
         command += ["--plant", plant]
     if plant_config is not None:

@@ -28,26 +28,29 @@ from crest.testbed_service.state_file import ServedTestbed, claim_serving, confi
 def serve_until_stopped(config: TestbedConfig, *, plant: str | None = None, plant_config: Path | None = None,
                         effects: dict | None = None, faults: Sequence[str] = (), port: int = 0,
                         on_ready: Callable[[ServedTestbed, Path], None] = lambda served, path: None,
-                        parent_fd: int | None = None) -> None:
+                        parent_fd: int | None = None, simulated_time: bool = False) -> None:
     """Serve the virtual testbed of `config` until a signal's handler raises (KeyboardInterrupt
     for SIGINT, crest.driver.Terminated for SIGTERM); that exception propagates after the clean-up.
     on_ready(served, state file) is called once the state file is written. parent_fd: the read end
     of the starting command's pipe; a byte on it starts the fault clock, its end sends this process
-    SIGTERM (see module doc)."""
+    SIGTERM (see module doc). simulated_time: the testbed's clock moves only with the TIME stamps
+    its master sends (sim_backend.time_stamps), not with the wall clock."""
     clock_requests = threading.Event()
     if parent_fd is not None:
         threading.Thread(target=_watch_parent, args=(parent_fd, clock_requests), name="parent-pipe",
                          daemon=True).start()
     with claim_serving() as publish:
         server = serve_virtual_testbed(config, plant=plant, plant_config=plant_config, effects=effects,
-                                       faults=faults, faults_wait_for_run=parent_fd is not None, port=port)
+                                       faults=faults, faults_wait_for_run=parent_fd is not None, port=port,
+                                       simulated_time=simulated_time)
         if parent_fd is not None:
             threading.Thread(target=_start_fault_clock_when_asked, args=(clock_requests, server.testbed),
                              name="fault-clock", daemon=True).start()
         try:
             served = ServedTestbed(pid=os.getpid(), bus_interface=server.bus_interface,
                                    bus_channel=server.bus_channel, tracker_port=server.tracker_port,
-                                   config=str(Path(config.path).resolve()), config_digest=config_digest(config))
+                                   config=str(Path(config.path).resolve()), config_digest=config_digest(config),
+                                   simulated_time=simulated_time)
             publish(served)
             on_ready(served, state_path())
             while True:

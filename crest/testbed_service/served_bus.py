@@ -11,6 +11,7 @@ it would on hardware; `lost` keeps what ended the connection.
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 
 import can
 from can_remote.client import RemoteBus
@@ -24,15 +25,21 @@ class ServedBus(RemoteBus):
 
     def __init__(self, channel: str, **config) -> None:
         self.lost: Exception | None = None
+        self.receive_hooks: list[Callable[[can.Message], None]] = []   # each sees every frame received
         self._closed = threading.Event()
         super().__init__(channel, **config)
 
     def recv(self, timeout: float | None = None) -> can.Message | None:
         if self.lost is None:
             try:
-                return super().recv(timeout)
+                msg = super().recv(timeout)
             except CONNECTION_ERRORS as exc:
                 self.lost = exc
+            else:
+                if msg is not None:
+                    for hook in self.receive_hooks:
+                        hook(msg)
+                return msg
         self._closed.wait(timeout)
         return None
 

@@ -24,13 +24,13 @@ def crest_lines(stderr: str) -> list[str]:
     return [line for line in stderr.splitlines() if line.startswith("crest")]
 
 
-def start_recorded_run(log_path) -> subprocess.Popen:
+def start_recorded_run(log_path, env: dict[str, str] | None = None) -> subprocess.Popen:
     """A long `crest run builtin:circle --fast --record LOG`, returned once rows are on disk.
 
     Simulated time (--fast): the drives count their heartbeat timeouts in it, so a loaded machine
     cannot starve the run into a stop of its own."""
     process = start_crest("run", "builtin:circle", "--periods", "100", "--fast", "--record", str(log_path),
-                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                          env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 300
     while not log_path.exists() or log_path.read_bytes().count(b"\n") < 20:
         assert time.monotonic() < deadline and process.poll() is None, process.communicate()
@@ -56,18 +56,19 @@ def real_bus_config(tmp_path):
     return path
 
 
-def test_estop_beside_a_run_in_simulated_time_refuses_and_reaches_nothing(tmp_path):
-    """A --fast run keeps its virtual testbed inside its own process: estop cannot reach it and says so.
-    (Beside a real-time run, estop reaches the drives: tests/serve.)"""
+def test_estop_beside_a_run_with_its_testbed_in_its_own_process_refuses_and_reaches_nothing(tmp_path):
+    """With CREST_VIRTUAL_TESTBED=in-process a run keeps its virtual testbed inside its own process:
+    estop cannot reach it and says so. (By default, estop reaches the drives of a real-time run and of
+    a --fast one: tests/serve.)"""
     log_path = tmp_path / "run.csv"
-    run = start_recorded_run(log_path)
+    run = start_recorded_run(log_path, env={"CREST_VIRTUAL_TESTBED": "in-process"})
     try:
         estop = crest("estop")
         assert estop.returncode == ExitCode.ERROR, estop.stderr
         assert estop.stdout == ""                              # no axis was opened, booted or stopped
         lines = crest_lines(estop.stderr)
         assert len(lines) == 1 and "Traceback" not in estop.stderr
-        assert "no virtual testbed is running" in lines[0] and "--fast" in lines[0] and "Ctrl-C" in lines[0]
+        assert "no virtual testbed is running" in lines[0] and "in-process" in lines[0] and "Ctrl-C" in lines[0]
         # The run beside it goes on as before: still running, still writing rows.
         rows = rows_on_disk(log_path)
         deadline = time.monotonic() + 60

@@ -38,7 +38,7 @@ def bend_to_45_deg():
 def test_a_tool_missing_in_the_first_frames_is_not_yet_tracker_loss():
     trajectory = bend_to_45_deg()
     controller = make_controller("dahl+fb", WORKSPACE, LIMITS, PERIOD_S, loss_timeout_s=LOSS_TIMEOUT_S)
-    with open_session(SessionOptions(realtime=False)) as session:
+    with open_session(SessionOptions(realtime=False, in_process=True)) as session:
         session.testbed.home()
         tracker = session.backend.virtual.tracker
         tracker.inject(TrackerFault.MISSING_TOOL)
@@ -58,7 +58,7 @@ def test_a_tool_missing_from_the_start_for_longer_than_the_timeout_stops_every_a
     trajectory = bend_to_45_deg()
     controller = make_controller("dahl+fb", WORKSPACE, LIMITS, PERIOD_S, loss_timeout_s=LOSS_TIMEOUT_S)
     cycles = []
-    with open_session(SessionOptions(realtime=False)) as session:
+    with open_session(SessionOptions(realtime=False, in_process=True)) as session:
         session.testbed.home()
         session.backend.virtual.tracker.inject(TrackerFault.MISSING_TOOL)
         with pytest.raises(SafetyStop) as stop:
@@ -73,7 +73,7 @@ def test_a_tool_missing_from_the_start_for_longer_than_the_timeout_stops_every_a
 
 def test_a_closed_loop_run_without_a_tracker_is_refused_before_anything_moves():
     controller = make_controller("dahl+fb", WORKSPACE, LIMITS, PERIOD_S)
-    with open_session(SessionOptions(realtime=False, tracker=False)) as session:
+    with open_session(SessionOptions(realtime=False, in_process=True, tracker=False)) as session:
         session.testbed.home()
         before = session.testbed.positions()
         with pytest.raises(ValueError, match="needs the tip tracker"):

@@ -26,7 +26,7 @@ HOME = Articulation(0.0, 0.0, CONFIG.insertion_axis.home_position_mm)
 
 
 def session_options(**overrides):
-    return SessionOptions(realtime=False, effects={"gravity": {}}, **overrides)
+    return SessionOptions(realtime=False, in_process=True, effects={"gravity": {}}, **overrides)
 
 
 class ErrorLog:

@@ -65,12 +65,12 @@ class ServedTestbed:
         return start_crest(*args, env=self.env, **kwargs)
 
 
-def start_served_testbed(tmp_path: Path, config: Path | None = None) -> ServedTestbed:
-    """`crest testbed serve`, returned once its state file is written (the caller stops it)."""
+def start_served_testbed(tmp_path: Path, config: Path | None = None, *options: str) -> ServedTestbed:
+    """`crest testbed serve [options]`, returned once its state file is written (the caller stops it)."""
     env = {"XDG_RUNTIME_DIR": str(tmp_path / "runtime")}
     config = config or relaxed_config(tmp_path / "config")
     state_file = tmp_path / "runtime" / "crest" / "testbed.json"
-    process = start_crest("testbed", "serve", "--config", str(config), env=env,
+    process = start_crest("testbed", "serve", "--config", str(config), *options, env=env,
                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     served = ServedTestbed(process, config, env, state_file)
     deadline = time.monotonic() + START_TIMEOUT_S

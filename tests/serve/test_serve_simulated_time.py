@@ -1,0 +1,92 @@
+"""Simulated time across the process boundary. A command run with --fast starts a testbed process
+of its own, as every command does, and moves its clock with CANopen TIME stamps on the bus
+(sim_backend.time_stamps): other processes reach it as they reach a real-time one, and faults cross
+the boundary the same way. A real-time command cannot use a testbed served in simulated time."""
+import json
+import subprocess
+
+import can
+
+from crest.exit_codes import ExitCode
+from crest.log import read_log
+from served_testbed import crest_lines, start_served_testbed, stop, wait_for_rows, wait_gone
+from sim_backend.time_stamps import TIME_COB_ID, time_stamp_seconds
+from tests.cli.cli_runner import crest, start_crest
+
+AXES = ("tendon1", "tendon2", "tendon3", "tendon4", "insertion")
+
+
+def start_fast_run(log_path, *options):
+    """A long `crest run builtin:circle --fast` with a testbed of its own, returned once it writes rows."""
+    run = start_crest("run", "builtin:circle", "--fast", "--insertion-mm", "25", "--periods", "100",
+                      "--record", str(log_path), *options, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        wait_for_rows(log_path, 20, run)
+    except BaseException:
+        stop(run)
+        raise
+    return run
+
+
+def time_stamps_s(blf_path):
+    return [time_stamp_seconds(f.data) for f in can.LogReader(blf_path) if f.arbitration_id == TIME_COB_ID]
+
+
+def test_a_fast_run_drives_its_own_testbed_process_by_time_stamps_and_estop_from_another_process_stops_it(
+        tmp_path, own_runtime_dir):
+    log_path = tmp_path / "run.csv"
+    state_file = own_runtime_dir / "crest" / "testbed.json"
+    run = start_fast_run(log_path)
+    try:
+        state = json.loads(state_file.read_text())
+        estop = crest("estop")
+        _, stderr = run.communicate(timeout=120)
+    finally:
+        stop(run)
+    assert state["simulated_time"] is True and state["pid"] != run.pid
+    assert estop.returncode == ExitCode.OK, estop.stdout + estop.stderr
+    assert [line.split()[:2] for line in estop.stdout.splitlines()] == [[axis, "stopped"] for axis in AXES]
+    lines = crest_lines(stderr)
+    assert run.returncode == ExitCode.ERROR and len(lines) == 1 and "crest estop" in lines[0], stderr
+    stamps = time_stamps_s(log_path.with_suffix(".blf"))
+    assert len(stamps) >= 20 and stamps == sorted(stamps)
+    assert stamps[-1] >= read_log(log_path).t_s[-1]     # the testbed's clock kept up with the log's
+    wait_gone(state["pid"], state_file)
+
+
+def test_kill_9_of_a_testbed_in_simulated_time_stops_the_fast_run_on_every_axis_heartbeat_lost(
+        tmp_path, own_runtime_dir):
+    log_path = tmp_path / "run.csv"
+    state_file = own_runtime_dir / "crest" / "testbed.json"
+    run = start_fast_run(log_path)
+    try:
+        testbed_pid = json.loads(state_file.read_text())["pid"]
+        subprocess.run(["kill", "-9", str(testbed_pid)], check=True)
+        _, stderr = run.communicate(timeout=120)
+    finally:
+        stop(run)
+    assert run.returncode == ExitCode.HEARTBEAT_LOST, stderr
+    lines = crest_lines(stderr)
+    assert len(lines) == 1 and "Traceback" not in stderr, stderr
+    named = lines[0].split("(HEARTBEAT_LOST): ")[1].split(": no heartbeat from ")[0]
+    assert sorted(named.split(", ")) == sorted(AXES), lines[0]
+    summary = json.loads(log_path.with_suffix(".json").read_text())["summary"]
+    assert summary["exit_code"] == ExitCode.HEARTBEAT_LOST and len(read_log(log_path)) >= 20
+
+
+def test_a_testbed_served_in_simulated_time_refuses_real_time_commands_and_follows_a_fast_one(tmp_path):
+    served = start_served_testbed(tmp_path, None, "--simulated-time")
+    try:
+        assert served.state["simulated_time"] is True
+        status = served.crest("status", "--config", str(served.config))
+        log_path = tmp_path / "run.csv"
+        run = served.crest("run", "builtin:circle", "--config", str(served.config), "--fast", "--insertion-mm", "25",
+                           "--periods", "1", "--record", str(log_path))
+        still_serving = served.process.poll() is None
+    finally:
+        stop(served.process)
+    assert status.returncode == ExitCode.ERROR and "--fast" in status.stderr and status.stdout == "", status.stderr
+    assert run.returncode == ExitCode.OK, run.stderr
+    stamps = time_stamps_s(log_path.with_suffix(".blf"))
+    assert stamps and stamps[-1] >= read_log(log_path).t_s[-1]
+    assert still_serving        # the command drove the served testbed; it did not start or stop one
