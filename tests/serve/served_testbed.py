@@ -16,6 +16,7 @@ import re
 import signal
 import subprocess
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -121,11 +122,16 @@ def wait_for_rows(log_path: Path, rows: int, process: subprocess.Popen, timeout_
 
 
 def start_run(served: ServedTestbed, log_path: Path) -> subprocess.Popen:
-    """A long real-time `crest run builtin:circle --record LOG` on the served testbed, returned once
-    its trajectory writes rows. The free length of 25 mm keeps the move to the start short."""
-    run = served.start_crest("run", "builtin:circle", "--config", str(served.config), "--insertion-mm", "25",
-                             "--periods", "100", "--record", str(log_path),
-                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    """A long real-time `crest run builtin:circle --record LOG` on the served testbed (see start_circle)."""
+    return start_circle(served.start_crest, log_path, "--config", str(served.config))
+
+
+def start_circle(start: Callable[..., subprocess.Popen], log_path: Path, *options: str) -> subprocess.Popen:
+    """A long `crest run builtin:circle --record LOG [options]`, started by `start` (start_crest with
+    its environment), returned once its trajectory writes rows. The free length of 25 mm keeps the
+    move to the start short."""
+    run = start("run", "builtin:circle", "--insertion-mm", "25", "--periods", "100", "--record", str(log_path),
+                *options, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         wait_for_rows(log_path, 20, run)
     except BaseException:

@@ -6,26 +6,27 @@ import json
 import subprocess
 
 import can
+import pytest
 
 from crest.exit_codes import ExitCode
 from crest.log import read_log
-from served_testbed import crest_lines, start_served_testbed, stop, wait_for_rows, wait_gone
+from served_testbed import crest_lines, start_circle, start_served_testbed, stop, wait_gone
 from sim_backend.time_stamps import TIME_COB_ID, time_stamp_seconds
 from tests.cli.cli_runner import crest, start_crest
 
 AXES = ("tendon1", "tendon2", "tendon3", "tendon4", "insertion")
 
 
-def start_fast_run(log_path, *options):
-    """A long `crest run builtin:circle --fast` with a testbed of its own, returned once it writes rows."""
-    run = start_crest("run", "builtin:circle", "--fast", "--insertion-mm", "25", "--periods", "100",
-                      "--record", str(log_path), *options, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+@pytest.fixture
+def fast_run(tmp_path, own_runtime_dir):
+    """A long `crest run builtin:circle --fast` with a testbed of its own, writing rows: (the run, its
+    log path, the state file of its testbed)."""
+    log_path = tmp_path / "run.csv"
+    run = start_circle(start_crest, log_path, "--fast")
     try:
-        wait_for_rows(log_path, 20, run)
-    except BaseException:
+        yield run, log_path, own_runtime_dir / "crest" / "testbed.json"
+    finally:
         stop(run)
-        raise
-    return run
 
 
 def time_stamps_s(blf_path):
@@ -33,16 +34,11 @@ def time_stamps_s(blf_path):
 
 
 def test_a_fast_run_drives_its_own_testbed_process_by_time_stamps_and_estop_from_another_process_stops_it(
-        tmp_path, own_runtime_dir):
-    log_path = tmp_path / "run.csv"
-    state_file = own_runtime_dir / "crest" / "testbed.json"
-    run = start_fast_run(log_path)
-    try:
-        state = json.loads(state_file.read_text())
-        estop = crest("estop")
-        _, stderr = run.communicate(timeout=120)
-    finally:
-        stop(run)
+        fast_run):
+    run, log_path, state_file = fast_run
+    state = json.loads(state_file.read_text())
+    estop = crest("estop")
+    _, stderr = run.communicate(timeout=120)
     assert state["simulated_time"] is True and state["pid"] != run.pid
     assert estop.returncode == ExitCode.OK, estop.stdout + estop.stderr
     assert [line.split()[:2] for line in estop.stdout.splitlines()] == [[axis, "stopped"] for axis in AXES]
@@ -54,17 +50,10 @@ def test_a_fast_run_drives_its_own_testbed_process_by_time_stamps_and_estop_from
     wait_gone(state["pid"], state_file)
 
 
-def test_kill_9_of_a_testbed_in_simulated_time_stops_the_fast_run_on_every_axis_heartbeat_lost(
-        tmp_path, own_runtime_dir):
-    log_path = tmp_path / "run.csv"
-    state_file = own_runtime_dir / "crest" / "testbed.json"
-    run = start_fast_run(log_path)
-    try:
-        testbed_pid = json.loads(state_file.read_text())["pid"]
-        subprocess.run(["kill", "-9", str(testbed_pid)], check=True)
-        _, stderr = run.communicate(timeout=120)
-    finally:
-        stop(run)
+def test_kill_9_of_a_testbed_in_simulated_time_stops_the_fast_run_on_every_axis_heartbeat_lost(fast_run):
+    run, log_path, state_file = fast_run
+    subprocess.run(["kill", "-9", str(json.loads(state_file.read_text())["pid"])], check=True)
+    _, stderr = run.communicate(timeout=120)
     assert run.returncode == ExitCode.HEARTBEAT_LOST, stderr
     lines = crest_lines(stderr)
     assert len(lines) == 1 and "Traceback" not in stderr, stderr
