@@ -36,7 +36,8 @@ def rod_diagnosis(effects: str = "", noise_mm: float = 0.05) -> dict:
     with tempfile.TemporaryDirectory() as folder:
         plant = Path(folder) / "rod_plant.toml"
         plant.write_text(ROD_PLANT.format(effects=effects, noise_mm=noise_mm))
-        with open_session(SessionOptions(config=config, plant_config=plant, realtime=False)) as session:
+        # in this process, as the blind benchmark records its cases (the process boundary has tests/serve)
+        with open_session(SessionOptions(config=config, plant_config=plant, realtime=False, in_process=True)) as session:
             logs = record_excitation(session, plan_excitation(config, prior, short=True), Path(folder), prior)
         result = diagnose_logs([logs["train"].log_path], [logs["holdout"].log_path], settings=TEST_SETTINGS)
     return json.loads(json.dumps(result, allow_nan=False))     # strict JSON: every number finite or null
