@@ -31,6 +31,7 @@ from crest.config import TestbedConfig, load_testbed_config
 from crest.config.testbed_config import AxisConfig
 from crest.testbed_service import ServedTestbed, config_digest, running_testbed
 from crest.testbed_service.auto_start import MODE_VARIABLE, OwnedTestbed, start_owned_testbed, wants_own_process
+from crest.testbed_service.clock_claim import claim_clock
 from crest.testbed_service.served_bus import ServedBus
 from sim_backend.time_stamps import StampAnswers, time_stamp_frame
 
@@ -53,6 +54,7 @@ class Backend:
     served: ServedTestbed | None = None   # the served virtual testbed this process joined
     owned: OwnedTestbed | None = None     # ... when this process started it for itself
     stamp_answers: StampAnswers | None = None   # ... when it runs in simulated time
+    clock_lock_fd: int | None = None            # ... whose clock this process alone drives
 
     @property
     def is_virtual(self) -> bool:
@@ -91,6 +93,9 @@ class Backend:
             self.virtual.stop()
         if self.owned is not None:
             self.owned.stop()
+        if self.clock_lock_fd is not None:
+            os.close(self.clock_lock_fd)
+            self.clock_lock_fd = None
 
 
 def fault_kinds() -> dict[str, tuple[str, ...]]:
@@ -129,6 +134,33 @@ def open_backend(config: TestbedConfig, *, plant: str | None = None, plant_confi
     if served is not None and realtime and served.simulated_time:
         raise BackendError(f"the served virtual testbed ({served.describe()}) moves only with the simulated time of a "
                            "command run with --fast; add --fast, or stop it and serve one in real time")
+    # a command in simulated time drives the clock of the testbed process it joins or starts: one at a
+    # time (crest.testbed_service.clock_claim); a second one keeps its testbed in its own process
+    clock_lock_fd = None
+    if not realtime and wants_own_process() and (served is None or served.simulated_time):
+        clock_lock_fd = claim_clock()
+        if clock_lock_fd is None:
+            return _open_virtual(config, plant, plant_config, faults, effects or {}, realtime, tracker_noise_mm,
+                                 tracker_dropout)
+    try:
+        backend = _open_process_backend(config, served, realtime, plant, plant_config, faults, effects or {},
+                                        tracker_noise_mm, tracker_dropout)
+    except BaseException:
+        if clock_lock_fd is not None:
+            os.close(clock_lock_fd)
+        raise
+    if backend.stamp_answers is not None:
+        backend.clock_lock_fd = clock_lock_fd
+    elif clock_lock_fd is not None:
+        os.close(clock_lock_fd)
+    return backend
+
+
+def _open_process_backend(config: TestbedConfig, served: ServedTestbed | None, realtime: bool, plant: str | None,
+                          plant_config: Path | None, faults: Sequence[str], effects: dict,
+                          tracker_noise_mm: float | None, tracker_dropout: float | None) -> Backend:
+    """The served testbed joined, a testbed process of this command's own, or, where the command's
+    set-up cannot be handed over or a served testbed in the other kind of time runs, one in this process."""
     if served is not None and served.simulated_time != realtime:
         if plant or plant_config or faults or effects or tracker_noise_mm is not None or tracker_dropout is not None:
             raise BackendError("--plant, --plant-config, --fault, --effect and the tracker's noise and dropout "
@@ -140,9 +172,8 @@ def open_backend(config: TestbedConfig, *, plant: str | None = None, plant_confi
     # beside a served testbed in real time (one server per user) a command in simulated time keeps its own
     if (served is None and wants_own_process() and tracker_noise_mm is None and tracker_dropout is None
             and config_digest(load_testbed_config(config.path)) == config_digest(config)):
-        return _open_owned(config, plant, plant_config, effects or {}, faults, simulated_time=not realtime)
-    return _open_virtual(config, plant, plant_config, faults, effects or {}, realtime, tracker_noise_mm,
-                         tracker_dropout)
+        return _open_owned(config, plant, plant_config, effects, faults, simulated_time=not realtime)
+    return _open_virtual(config, plant, plant_config, faults, effects, realtime, tracker_noise_mm, tracker_dropout)
 
 
 def _open_owned(config: TestbedConfig, plant: str | None, plant_config: Path | None, effects: dict,

@@ -10,7 +10,8 @@ import pytest
 
 from crest.exit_codes import ExitCode
 from crest.log import read_log
-from served_testbed import crest_lines, start_circle, start_served_testbed, stop, wait_gone
+from served_testbed import (crest_lines, rows_on_disk, start_circle, start_served_testbed, stop, wait_for_rows,
+                            wait_gone)
 from sim_backend.time_stamps import TIME_COB_ID, time_stamp_seconds
 from tests.cli.cli_runner import crest, start_crest
 
@@ -79,3 +80,18 @@ def test_a_testbed_served_in_simulated_time_refuses_real_time_commands_and_follo
     stamps = time_stamps_s(log_path.with_suffix(".blf"))
     assert stamps and stamps[-1] >= read_log(log_path).t_s[-1]
     assert still_serving        # the command drove the served testbed; it did not start or stop one
+
+
+def test_a_second_fast_run_beside_one_that_drives_its_testbed_keeps_its_testbed_in_its_own_process(fast_run, tmp_path):
+    """One command drives a testbed's simulated clock: a second `--fast` run does not join the first
+    one's testbed process (it would move the same clock), but runs its own testbed inside itself."""
+    first, first_log, state_file = fast_run
+    testbed_pid = json.loads(state_file.read_text())["pid"]
+    second_log = tmp_path / "second.csv"
+    second = crest("run", "builtin:circle", "--fast", "--insertion-mm", "25", "--periods", "1",
+                   "--record", str(second_log))
+    assert second.returncode == ExitCode.OK, second.stderr
+    assert time_stamps_s(second_log.with_suffix(".blf")) == []          # its clock drove no other process
+    assert first.poll() is None and json.loads(state_file.read_text())["pid"] == testbed_pid
+    rows = rows_on_disk(first_log)
+    wait_for_rows(first_log, rows + 20, first)                         # the first run goes on
