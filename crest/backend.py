@@ -127,9 +127,9 @@ def open_backend(config: TestbedConfig, *, plant: str | None = None, plant_confi
             raise BackendError(f"{config.path}: [tracker].port = 'sim' needs the virtual testbed; "
                                "set it to the tracker's serial device")
         return Backend(bus=_open_hardware_bus(config), tracker_port=config.tracker.port)
+    effects = effects or {}
     if in_process:
-        return _open_virtual(config, plant, plant_config, faults, effects or {}, realtime, tracker_noise_mm,
-                             tracker_dropout)
+        return _open_virtual(config, plant, plant_config, faults, effects, realtime, tracker_noise_mm, tracker_dropout)
     served = running_testbed()
     if served is not None and realtime and served.simulated_time:
         raise BackendError(f"the served virtual testbed ({served.describe()}) moves only with the simulated time of a "
@@ -140,10 +140,10 @@ def open_backend(config: TestbedConfig, *, plant: str | None = None, plant_confi
     if not realtime and wants_own_process() and (served is None or served.simulated_time):
         clock_lock_fd = claim_clock()
         if clock_lock_fd is None:
-            return _open_virtual(config, plant, plant_config, faults, effects or {}, realtime, tracker_noise_mm,
+            return _open_virtual(config, plant, plant_config, faults, effects, realtime, tracker_noise_mm,
                                  tracker_dropout)
     try:
-        backend = _open_process_backend(config, served, realtime, plant, plant_config, faults, effects or {},
+        backend = _open_process_backend(config, served, realtime, plant, plant_config, faults, effects,
                                         tracker_noise_mm, tracker_dropout)
     except BaseException:
         if clock_lock_fd is not None:

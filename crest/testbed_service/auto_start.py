@@ -1,8 +1,9 @@
 """A served virtual testbed started for one command and stopped with it.
 
 A command that finds no served testbed starts `crest testbed serve` as its child (with
-`--simulated-time` for a command in simulated time, `--fast`), joins it like any served testbed (so `crest estop` and `crest status` reach it from other processes),
-and stops it when the command ends. The child holds the read end of a pipe whose only writer is
+`--simulated-time` for a command in simulated time, `--fast`), joins it like any served testbed
+(so `crest estop` and `crest status` reach it from other processes), and stops it when the
+command ends. The child holds the read end of a pipe whose only writer is
 the command: when the command ends, however it ends (a crash, kill -9), the kernel closes the
 pipe and the child stops itself (serve.py). The same pipe carries the command's one message to
 its testbed: a byte that starts the fault clock of its `--fault`s (`OwnedTestbed.start_fault_clock`).
