@@ -33,7 +33,7 @@ from crest.testbed_service import ServedTestbed, config_digest, running_testbed
 from crest.testbed_service.auto_start import MODE_VARIABLE, OwnedTestbed, start_owned_testbed, wants_own_process
 from crest.testbed_service.clock_claim import claim_clock
 from crest.testbed_service.served_bus import ServedBus
-from sim_backend.time_stamps import StampAnswers, time_stamp_frame
+from sim_backend.time_stamps import StampAnswers, fault_clock_frame, time_stamp_frame
 
 _channel_numbers = itertools.count(1)
 INSERTION_START_ABOVE_HOME_MM = 2.0   # the simulated pulley block powers up this far from its switch
@@ -69,11 +69,15 @@ class Backend:
         return can.Bus(interface="virtual", channel=self.virtual.channel)
 
     def start_fault_clock(self) -> None:
-        """The virtual testbed's --fault times count from now (the start of the run's motion);
-        no-op on hardware and on a served testbed this process did not start."""
+        """The virtual testbed's --fault times count from now (the start of the run's motion):
+        the testbed in this process starts its clock; one this process started hears it on the
+        bus in simulated time, in order with the TIME stamps (sim_backend.time_stamps), and on its
+        pipe in real time. No-op on hardware and on a served testbed this process did not start."""
         if self.virtual is not None:
             self.virtual.start_fault_clock()
-        if self.owned is not None:
+        elif self.owned is not None and self.stamp_answers is not None:
+            self.bus.send(fault_clock_frame())
+        elif self.owned is not None:
             self.owned.start_fault_clock()
 
     def tick(self, now_s: float) -> None:

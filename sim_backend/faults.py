@@ -25,6 +25,8 @@ import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
+from sim_backend.sim_time import whole_us
+
 TRACKER_AXIS = "tracker"
 
 
@@ -103,7 +105,8 @@ def parse_fault(text: str) -> FaultSpec:
 class FaultSchedule:
     """Faults waiting for their time; ``due(now_s)`` hands each one out once.
 
-    A fault at ``at_s`` is due when ``now_s >= clock_zero_s + at_s``. The clock starts at 0 (the
+    A fault at ``at_s`` is due when ``now_s - clock_zero_s >= at_s`` (in whole microseconds,
+    sim_backend.sim_time). The clock starts at 0 (the
     testbed's start) unless the schedule is ``held``: then nothing is due until ``start_clock(now_s)``
     sets ``clock_zero_s = now_s`` (once; later calls keep the first zero).
     """
@@ -119,9 +122,9 @@ class FaultSchedule:
     def due(self, now_s: float) -> list[FaultSpec]:
         if self._clock_zero_s is None:
             return []
-        elapsed_s = now_s - self._clock_zero_s
-        ready = [fault for fault in self._waiting if fault.at_s <= elapsed_s]
-        self._waiting = [fault for fault in self._waiting if fault.at_s > elapsed_s]
+        elapsed_us = whole_us(now_s - self._clock_zero_s)
+        ready = [fault for fault in self._waiting if whole_us(fault.at_s) <= elapsed_us]
+        self._waiting = [fault for fault in self._waiting if whole_us(fault.at_s) > elapsed_us]
         return ready
 
     @property

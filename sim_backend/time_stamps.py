@@ -23,10 +23,16 @@ ahead of the heartbeats, never a heartbeat timeout. The wait costs nothing in a 
 come after the answer. A testbed that does not answer within the wait is taken as gone: the
 master stops waiting (until it answers again) and its heartbeat watch, in simulated time, finds
 the drives silent.
+
+A command's `--fault` times count from the start of its motion. In simulated time the command says
+when that is with a FAULT_CLOCK_COB_ID frame (0x102, no data; the virtual testbed's own too) on the
+bus, right after the stamp of that moment, so the testbed starts the fault clock at the time of the
+stamp before it, in order with the stamps, as a testbed inside the command's process would.
 """
 from __future__ import annotations
 
 import struct
+import sys
 import threading
 import time
 from collections.abc import Callable
@@ -35,6 +41,7 @@ import can
 
 TIME_COB_ID = 0x100
 TIME_ACK_COB_ID = 0x101
+FAULT_CLOCK_COB_ID = 0x102
 MS_PER_DAY = 86_400_000
 POLL_S = 0.1        # how often a wait looks whether the bus is gone
 
@@ -59,6 +66,29 @@ def time_stamp_seconds(data: bytes) -> float:
 def time_ack_frame(data: bytes) -> can.Message:
     """The testbed's answer to the TIME stamp with these data bytes."""
     return can.Message(arbitration_id=TIME_ACK_COB_ID, is_extended_id=False, data=bytes(data))
+
+
+def fault_clock_frame() -> can.Message:
+    """The frame that starts a testbed's fault clock at the time of the last stamp."""
+    return can.Message(arbitration_id=FAULT_CLOCK_COB_ID, is_extended_id=False, data=b"")
+
+
+def follow_time_stamps(drives, tick: Callable[[float], None],
+                       start_fault_clock: Callable[[], None] = lambda: None) -> None:
+    """The testbed's side: each TIME stamp on the bus of `drives` (a SimDriveSet, started) calls
+    tick(now_s), then is answered, and a fault clock frame calls start_fault_clock(); in the drives'
+    receive thread, so in order with their frames."""
+    def on_stamp(can_id: int, data: bytearray, timestamp: float) -> None:
+        try:
+            now_s = time_stamp_seconds(data)
+        except ValueError as exc:       # a frame some other node sent with this COB-ID
+            print(f"virtual testbed: TIME stamp ignored: {exc}", file=sys.stderr, flush=True)
+            return
+        tick(now_s)
+        drives.send(time_ack_frame(data))
+
+    drives.subscribe(TIME_COB_ID, on_stamp)
+    drives.subscribe(FAULT_CLOCK_COB_ID, lambda can_id, data, timestamp: start_fault_clock())
 
 
 class StampAnswers:

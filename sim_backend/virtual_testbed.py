@@ -15,7 +15,6 @@ sends on the bus when `start(time_stamps=True)` (sim_backend.time_stamps).
 """
 from __future__ import annotations
 
-import sys
 import threading
 import time
 from collections.abc import Sequence
@@ -25,7 +24,7 @@ from sim_backend.drive.drive_spec import DriveSpec
 from sim_backend.drives import SimDriveSet
 from sim_backend.faults import FaultSchedule, FaultSpec
 from sim_backend.plant import Plant, PlantError, PlantRunner
-from sim_backend.time_stamps import TIME_COB_ID, time_ack_frame, time_stamp_seconds
+from sim_backend.time_stamps import follow_time_stamps
 from sim_backend.tracker import SimTracker
 
 TENDON_AXES = ("tendon1", "tendon2", "tendon3", "tendon4")
@@ -74,7 +73,7 @@ class VirtualTestbed:
         self.drives.start()
         self.drives.add_sync_listener(self._on_sync)
         if time_stamps:
-            self.drives.subscribe(TIME_COB_ID, self._on_time_stamp)
+            follow_time_stamps(self.drives, self.tick, self.start_fault_clock)
         self.tracker.start()
         if self.plant_in_thread:
             self.plant_runner.start_thread()
@@ -118,15 +117,6 @@ class VirtualTestbed:
         self.drives.tick(now_s)
         for fault in self._tracker_faults.due(now_s):
             self.tracker.inject(fault.kind.value)
-
-    def _on_time_stamp(self, can_id: int, data: bytearray, timestamp: float) -> None:
-        try:
-            now_s = time_stamp_seconds(data)
-        except ValueError as exc:       # a frame some other node sent with this COB-ID
-            print(f"virtual testbed: TIME stamp ignored: {exc}", file=sys.stderr, flush=True)
-            return
-        self.tick(now_s)
-        self.drives.send(time_ack_frame(data))
 
     def _tick_in_real_time(self) -> None:
         while not self._stop.wait(REALTIME_TICK_S):

@@ -5,8 +5,10 @@ A command that finds no served testbed starts `crest testbed serve` as its child
 (so `crest estop` and `crest status` reach it from other processes), and stops it when the
 command ends. The child holds the read end of a pipe whose only writer is
 the command: when the command ends, however it ends (a crash, kill -9), the kernel closes the
-pipe and the child stops itself (serve.py). The same pipe carries the command's one message to
-its testbed: a byte that starts the fault clock of its `--fault`s (`OwnedTestbed.start_fault_clock`).
+pipe and the child stops itself (serve.py). In real time the same pipe carries the command's one
+message to its testbed: a byte that starts the fault clock of its `--fault`s
+(`OwnedTestbed.start_fault_clock`); in simulated time a frame on the bus does, in order with the
+TIME stamps (sim_backend.time_stamps).
 
 With ``CREST_VIRTUAL_TESTBED=in-process`` in the environment, a command boots the virtual testbed
 inside its own process instead, on python-can's in-process bus (faster to start, reachable by

@@ -8,8 +8,9 @@ drives and the tracker stop, and the state file is removed before the lock is re
 A testbed started for one command (auto_start.py) also watches a pipe from that command: the
 kernel closes it when the command ends, however it ends (kill -9 included), and the end of the
 pipe stops the testbed as SIGTERM does, so no testbed outlives the command that started it. A
-byte on the pipe starts the fault clock: the command's --fault times count from its motion's
-start, as they do with the testbed inside the command. A testbed served on its own has no such
+byte on the pipe starts the fault clock in real time (in simulated time a frame on the bus does,
+sim_backend.time_stamps): the command's --fault times count from its motion's start, as they do
+with the testbed inside the command. A testbed served on its own has no such
 command, and its fault times count from its start.
 """
 from __future__ import annotations

@@ -12,6 +12,8 @@ turns them into times.
 
 from __future__ import annotations
 
+from sim_backend.sim_time import whole_us
+
 
 def decode_consumer_entry(entry: int) -> tuple[int, float]:
     """(producer node id, consumer time in s) of a 0x1016 sub-entry."""
@@ -39,14 +41,15 @@ class HeartbeatConsumer:
         self._received = True
 
     def tick(self, now_s: float) -> bool:
-        """True exactly once when the producer's heartbeat has been missing longer than the timeout."""
+        """True exactly once when the producer's heartbeat has been missing longer than the timeout
+        (compared in whole microseconds, sim_backend.sim_time)."""
         if not self.enabled:
             return False
         if self._received:
             self._received = False
             self._last_seen_s = now_s
             return False
-        if self._last_seen_s is not None and now_s - self._last_seen_s > self.timeout_s:
+        if self._last_seen_s is not None and whole_us(now_s - self._last_seen_s) > whole_us(self.timeout_s):
             self._last_seen_s = None
             return True
         return False

@@ -22,6 +22,8 @@ from typing import Callable
 
 from canopen.nmt import NmtSlave
 
+from sim_backend.sim_time import whole_us
+
 BOOT_UP_STATE = 0x00
 PRE_OPERATIONAL = 127
 OPERATIONAL = 5
@@ -92,12 +94,13 @@ class TickedNmtSlave(NmtSlave):
         """The heartbeat is built from the current state when sent; nothing to update."""
 
     def tick(self, now_s: float) -> None:
-        """Send the heartbeat if one producer period has passed since the last one."""
+        """Send the heartbeat if one producer period has passed since the last one (compared in
+        whole microseconds, sim_backend.sim_time)."""
         if self._heartbeat_time_ms <= 0 or self._state == BOOT_UP_STATE:
             return
         if self._last_heartbeat_s is None:
             self._last_heartbeat_s = now_s
             return
-        if now_s - self._last_heartbeat_s >= self._heartbeat_time_ms / 1000.0:
+        if whole_us(now_s - self._last_heartbeat_s) >= self._heartbeat_time_ms * 1000:
             self._last_heartbeat_s = now_s
             self._send(0x700 + self.id, bytes([self._state]))

@@ -1,37 +1,49 @@
-"""Test rig: simulated drives (sim_backend) and a Testbed on a private virtual CAN channel.
+"""Test rig: the simulated drives in a process of their own, and a Testbed that meets them across
+the process boundary, on the bus the drives' process serves over python-can-remote (127.0.0.1).
 
-Time: the testbed runs on a SteppedClock whose every step ticks the simulated drive set, so
-heartbeats, heartbeat timeouts and scheduled faults happen in simulated time, and the drives
-move one cycle per SYNC the driver sends. Nothing sleeps; replies are waited for on conditions.
-A recorder on a third bus instance sees every frame in the order it was sent.
+Time: the testbed runs on a SteppedClock. Each step sends a CANopen TIME stamp that moves the
+drives' process to that time (sim_backend.time_stamps, as a `--fast` command drives a testbed
+served in simulated time) and waits for the drives' answer, so heartbeats, heartbeat timeouts and
+scheduled faults happen in simulated time, in step with the master, and the drives move one cycle
+per SYNC the driver sends. Nothing sleeps; replies are waited for on conditions.
+
+A recorder, a third client of the bus, sees every frame in the order the bus carried it. The test
+reads the drives and breaks them through the rig (`drive_states`, `inject_fault`, ...), which asks
+the drives' process (drive_process.py) once the drives have handled every frame sent before.
 """
 
 from __future__ import annotations
 
+import multiprocessing
 import struct
 import threading
-import uuid
 from dataclasses import replace
 
 import can
 
+import drive_process
 from crest.config import TestbedConfig, load_testbed_config
 from crest.driver import SteppedClock, Testbed
+from crest.testbed_service.served_bus import ServedBus
+from drive_process import MARKER_COB_ID, MARKER_ECHO_COB_ID, serve_drives
 from sim_backend.drive.drive_spec import DriveSpec
-from sim_backend.drives import SimDriveSet
+from sim_backend.faults import FaultKind
+from sim_backend.time_stamps import TIME_ACK_COB_ID, time_stamp_frame
 
-WAIT_S = 2.0
+#: Wall time a reply may take: the drives' process answers from its own threads, which a loaded
+#: 2-core machine can hold back for well over 0.1 s.
+WAIT_S = 10.0
+#: Wall time the drives' process may take to start (a fresh interpreter importing canopen).
+START_TIMEOUT_S = 60.0
 #: Where the insertion carriage stands at power-up: 1 mm above its limit switch (home, 20 mm).
 INSERTION_START_MM = 21.0
-#: An identifier no node uses: the rig's marker frame (see Rig.frames).
-MARKER_COB_ID = 0x7FF
 STOPPED_STATES = {"QUICK_STOP_ACTIVE", "SWITCH_ON_DISABLED", "FAULT"}
 
 
 def make_config(**master_overrides) -> TestbedConfig:
     """configs/testbed.toml, with ``master_overrides`` replacing fields of its [master] table.
 
-    The SDO and boot timeouts are wall time: the simulated drives answer from their own thread,
+    The SDO and boot timeouts are wall time: the simulated drives answer from their own process,
     which a loaded machine can hold back for well over 0.1 s. Only a test that expects the timeout
     to expire should shorten it.
     """
@@ -61,7 +73,7 @@ def drive_specs(config: TestbedConfig, insertion_start_mm: float = INSERTION_STA
 
 
 class FrameRecorder(can.Listener):
-    """Every frame on the channel, in the order they were sent."""
+    """Every frame on the bus, in the order they were carried."""
 
     def __init__(self) -> None:
         self.frames: list[can.Message] = []
@@ -76,9 +88,17 @@ class FrameRecorder(can.Listener):
         with self.arrived:
             return list(self.frames)
 
-    def wait_for(self, predicate, what: str) -> None:
+    def wait_for_frame(self, matches, after: int, what: str) -> None:
+        """Wait until a frame that `matches` arrives at an index >= `after`."""
+        searched = [after]
+
+        def arrived(frames) -> bool:
+            found = any(matches(frame) for frame in frames[searched[0]:])
+            searched[0] = len(frames)
+            return found
+
         with self.arrived:
-            if not self.arrived.wait_for(lambda: predicate(self.frames), timeout=WAIT_S):
+            if not self.arrived.wait_for(lambda: arrived(self.frames), timeout=WAIT_S):
                 raise AssertionError(f"timed out waiting for {what}")
 
     def stop(self) -> None:
@@ -86,46 +106,104 @@ class FrameRecorder(can.Listener):
 
 
 class Rig:
-    """Simulated drives, a Testbed on a stepped clock, and a recorder of every frame, on one channel."""
+    """The drives of `specs` in their own process, a Testbed on a stepped clock, and a recorder of
+    every frame, all on the bus the drives' process serves."""
 
     def __init__(self, config: TestbedConfig, specs: list[DriveSpec], faults=()) -> None:
         self.config = config
-        self.channel = f"crest-driver-{uuid.uuid4().hex}"
+        self.drive_names = [spec.name for spec in specs]
+        context = multiprocessing.get_context("spawn")
+        self._requests, child_end = context.Pipe()
+        self._process = context.Process(target=serve_drives, args=(specs, list(faults), child_end),
+                                        name="driver-rig-drives", daemon=True)
+        self._process.start()
+        child_end.close()
+        if not self._requests.poll(START_TIMEOUT_S):
+            self._process.kill()
+            raise AssertionError(f"the drives' process did not start within {START_TIMEOUT_S:g} s")
+        self.bus_url = self._requests.recv()
         self.recorder = FrameRecorder()
-        self._recorder_bus = can.Bus(interface="virtual", channel=self.channel)
+        self._recorder_bus = ServedBus(self.bus_url)
         self._recorder_notifier = can.Notifier(self._recorder_bus, [self.recorder], timeout=0.05)
-        self.drives = SimDriveSet(specs, self.channel, faults=faults)
-        self.drives.start()
-        self.bus = can.Bus(interface="virtual", channel=self.channel)
-        self.clock = SteppedClock(on_advance=self.drives.tick)
+        self.bus = ServedBus(self.bus_url)
+        self.frames()          # the recorder's handle is on the bus before the master sends anything
+        self.clock = SteppedClock(on_advance=self._move_drives_to)
         self.testbed = Testbed(self.bus, config, clock=self.clock)
 
-    def frames(self) -> list[can.Message]:
-        """Every frame sent so far: a marker frame goes out last and is waited for (no frame overtakes it)."""
-        self.bus.send(can.Message(arbitration_id=MARKER_COB_ID, data=b"", is_extended_id=False))
-        marks = sum(f.arbitration_id == MARKER_COB_ID for f in self.recorder.snapshot()) + 1
-        self.recorder.wait_for(lambda frames: sum(f.arbitration_id == MARKER_COB_ID for f in frames) >= marks,
-                               "the marker frame")
-        return [f for f in self.recorder.snapshot() if f.arbitration_id != MARKER_COB_ID]
+    def _move_drives_to(self, now_s: float) -> None:
+        """Send the TIME stamp of now_s and wait for the drives' answer to it."""
+        stamp = time_stamp_frame(now_s)
+        after = len(self.recorder.snapshot())
+        self.bus.send(stamp)
+        self.recorder.wait_for_frame(lambda frame: frame.arbitration_id == TIME_ACK_COB_ID and frame.data == stamp.data,
+                                     after, f"the drives' answer to the time stamp of {now_s:g} s")
 
-    def drive(self, name: str):
-        return self.drives.drive(name)
+    def open_bus(self) -> can.BusABC:
+        """Another client's handle on the rig's bus (shut it down after use)."""
+        return ServedBus(self.bus_url)
+
+    def frames(self) -> list[can.Message]:
+        """Every frame sent so far, the drives' answers included: a marker frame goes out on the
+        master's handle and the drives' process echoes it once it has handled every frame before
+        it (drive_process.py); the echo is waited for."""
+        marker = can.Message(arbitration_id=MARKER_COB_ID, data=b"", is_extended_id=False)
+        after = len(self.recorder.snapshot())
+        self.bus.send(marker)
+        self.recorder.wait_for_frame(lambda frame: frame.arbitration_id == MARKER_ECHO_COB_ID, after,
+                                     "the drives' echo of the marker frame")
+        return [f for f in self.recorder.snapshot() if f.arbitration_id not in (MARKER_COB_ID, MARKER_ECHO_COB_ID)]
+
+    def in_drives(self, request, *args):
+        """`request(drives, *args)` (a module-level function) run in the drives' process, after
+        they handled every frame sent; what it returns, or what it raised, raised here."""
+        self.frames()
+        self._requests.send((request, args))
+        if not self._requests.poll(WAIT_S):
+            raise AssertionError(f"the drives' process did not answer {request.__name__} within {WAIT_S:g} s")
+        succeeded, result = self._requests.recv()
+        if not succeeded:
+            raise result
+        return result
+
+    # --- what the test reads and breaks in the drives ------------------------------------------
+    def drive_states(self) -> dict[str, str]:
+        return self.in_drives(drive_process.drive_states)
+
+    def nmt_states(self) -> dict[str, str]:
+        return self.in_drives(drive_process.nmt_states)
+
+    def position_actual_mm(self, name: str) -> float:
+        return self.in_drives(drive_process.position_actual_mm, name)
+
+    def object_value(self, name: str, index: int, subindex: int = 0) -> int:
+        """The value of object index:subindex in the drive's own object dictionary."""
+        return self.in_drives(drive_process.object_value, name, index, subindex)
+
+    def active_error_codes(self, name: str) -> tuple[int, ...]:
+        return self.in_drives(drive_process.active_error_codes, name)
+
+    def inject_fault(self, name: str, kind: FaultKind) -> None:
+        self.in_drives(drive_process.inject_fault, name, kind)
+
+    def set_load_tension_n(self, name: str, tension_n: float) -> None:
+        self.in_drives(drive_process.set_load_tension_n, name, tension_n)
 
     def advance(self, duration_s: float) -> None:
         """Let simulated time pass with the host silent (no heartbeat, no SYNC)."""
         self.clock.advance(duration_s)
 
-    def drive_states(self) -> dict[str, str]:
-        return {name: drive.state.name for name, drive in self.drives.drives.items()}
-
     def close(self) -> None:
-        self.testbed.close()
-        self.drives.stop()
-        self.bus.shutdown()
-        self._recorder_notifier.stop()
-        self._recorder_bus.shutdown()
-
-
+        try:
+            self.testbed.close()
+        finally:
+            self.bus.shutdown()
+            self._recorder_notifier.stop()
+            self._recorder_bus.shutdown()
+            self._requests.close()            # the drives' process ends when its pipe closes
+            self._process.join(WAIT_S)
+            if self._process.is_alive():
+                self._process.kill()
+                self._process.join()
 
 
 # --- reading the recorded frames ---------------------------------------------------------------

@@ -1,12 +1,24 @@
 """Boot sequence against the simulated drives: NMT, identity, configuration, heartbeat, SYNC."""
 
+import os
 from dataclasses import replace
 
 import pytest
 
 from crest.driver import BootError, IdentityMismatch, ReadBackMismatch
 from crest.exit_codes import ExitCode
+from crest.testbed_service.served_bus import ServedBus
 from driver_rig import drive_specs, is_sync, make_config, sdo_downloads
+
+
+def process_id(drives) -> int:
+    """In the drives' process: its id."""
+    return os.getpid()
+
+
+def test_the_master_meets_the_drives_in_another_process_over_the_served_bus(booted):
+    assert booted.in_drives(process_id) != os.getpid()
+    assert isinstance(booted.bus, ServedBus) and booted.bus_url.startswith("ws://127.0.0.1:")
 
 
 def test_boot_resets_each_node_before_talking_to_it_and_ends_operational(booted):
@@ -19,26 +31,27 @@ def test_boot_resets_each_node_before_talking_to_it_and_ends_operational(booted)
         assert any(resets[0] < i < first_sdo for i in boot_ups), f"{axis.name}: SDO before its boot-up"
         start = next(i for i, f in enumerate(frames) if f.arbitration_id == 0x000 and bytes(f.data) == bytes([0x01, axis.node_id]))
         assert start > max(i for i, f in enumerate(frames) if f.arbitration_id == 0x600 + axis.node_id)
-        assert booted.drive(axis.name).nmt_state == "OPERATIONAL"
-        assert booted.drive(axis.name).state.name == "SWITCH_ON_DISABLED"
+        assert booted.nmt_states()[axis.name] == "OPERATIONAL"
+        assert booted.drive_states()[axis.name] == "SWITCH_ON_DISABLED"
 
 
 def test_boot_writes_the_axis_parameters_in_counts(booted):
     config = booted.config
     for axis in config.axes:
-        node = booted.drive(axis.name).node
+        def value(index, subindex=0, name=axis.name):
+            return booted.object_value(name, index, subindex)
         per_mm = axis.counts_per_mm
-        assert node.value(0x1006) == 10_000                                   # 10 ms SYNC period in us
-        assert node.value(0x6081) == round(axis.max_velocity_mm_s * per_mm)
-        assert node.value(0x6083) == node.value(0x6084) == round(axis.max_acceleration_mm_s2 * per_mm)
-        assert (node.value(0x607D, 1), node.value(0x607D, 2)) == (round(axis.soft_min_mm * per_mm),
+        assert value(0x1006) == 10_000                                   # 10 ms SYNC period in us
+        assert value(0x6081) == round(axis.max_velocity_mm_s * per_mm)
+        assert value(0x6083) == value(0x6084) == round(axis.max_acceleration_mm_s2 * per_mm)
+        assert (value(0x607D, 1), value(0x607D, 2)) == (round(axis.soft_min_mm * per_mm),
                                                                   round(axis.soft_max_mm * per_mm))
-        assert node.value(0x6065) == round(axis.following_error_window_mm * per_mm)
-        assert node.value(0x605A) == 2
-        assert node.value(0x6098) == axis.homing_method
-        assert node.value(0x1017) == 50
-        assert node.value(0x1016, 1) == 127 << 16 | 250                       # watch node 127, 250 ms
-        assert node.value(0x6061) == 1                                        # profile position
+        assert value(0x6065) == round(axis.following_error_window_mm * per_mm)
+        assert value(0x605A) == 2
+        assert value(0x6098) == axis.homing_method
+        assert value(0x1017) == 50
+        assert value(0x1016, 1) == 127 << 16 | 250                       # watch node 127, 250 ms
+        assert value(0x6061) == 1                                        # profile position
 
 
 def test_identity_is_reported_from_0x1018(make_rig):
@@ -108,7 +121,7 @@ def test_holding_keeps_the_drives_alive_past_their_heartbeat_timeout(booted):
 def test_status_reads_state_position_and_fault_of_every_axis(make_rig):
     from sim_backend.faults import FaultKind
     rig = make_rig()
-    rig.drive("tendon2").inject_fault(FaultKind.EMCY)     # before any host: nothing to stop
+    rig.inject_fault("tendon2", FaultKind.EMCY)     # before any host: nothing to stop
     rig.testbed.connect()
     for _ in range(6):
         rig.advance(0.01)                                 # one drive heartbeat period

@@ -23,7 +23,7 @@ def test_a_trajectory_is_followed_one_sync_behind(homed):
     trajectory = bend_there_and_back(homed.testbed)
     cycles = homed.testbed.run_trajectory(trajectory)
     assert len(cycles) == len(trajectory)
-    assert {homed.drive(name).node.value(0x6061) for name in homed.drives.drives} == {8}
+    assert {homed.object_value(name, 0x6061) for name in homed.drive_names} == {8}
     # The drives sample the position at the SYNC that latches the next set-point: sample k shows
     # where set-point k-1 took the axis.
     lags = [abs(now.position_mm[i] - before.target_mm[i])

@@ -15,7 +15,7 @@ def test_homing_references_every_axis_and_pretensions_the_tendons(homed):
     # Method 17: the carriage ran down onto its switch (1 mm below where it started) and the
     # drive now reports the switch as home_position_mm, the same frame as the mechanism.
     reported_mm = testbed.positions().insertion_mm
-    physical_mm = homed.drive("insertion").position_actual_mm
+    physical_mm = homed.position_actual_mm("insertion")
     assert reported_mm == pytest.approx(insertion.home_position_mm, abs=0.05)
     assert reported_mm == pytest.approx(physical_mm, abs=1.0 / insertion.counts_per_mm)
     assert physical_mm < INSERTION_START_MM - 0.9

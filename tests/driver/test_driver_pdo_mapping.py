@@ -9,15 +9,16 @@ from driver_rig import sdo_downloads
 
 def test_drives_carry_the_configured_mappings_and_transmission_types(booted):
     for axis in booted.config.axes:
-        node = booted.drive(axis.name).node
-        rpdo = [node.value(0x1600, sub) for sub in range(1, node.value(0x1600, 0) + 1)]
-        tpdo = [node.value(0x1A00, sub) for sub in range(1, node.value(0x1A00, 0) + 1)]
+        def value(index, subindex=0, name=axis.name):
+            return booted.object_value(name, index, subindex)
+        rpdo = [value(0x1600, sub) for sub in range(1, value(0x1600, 0) + 1)]
+        tpdo = [value(0x1A00, sub) for sub in range(1, value(0x1A00, 0) + 1)]
         assert rpdo == [mapping_entry(entry) for entry in axis.rpdo1] == [0x60400010, 0x607A0020]
         assert tpdo == [mapping_entry(entry) for entry in axis.tpdo1] == [0x60410010, 0x60640020, 0x60770010]
-        assert node.value(0x1400, 1) == 0x200 + axis.node_id and node.value(0x1400, 2) == 255   # event driven
-        assert node.value(0x1800, 1) == 0x40000180 + axis.node_id and node.value(0x1800, 2) == 1  # every SYNC
+        assert value(0x1400, 1) == 0x200 + axis.node_id and value(0x1400, 2) == 255   # event driven
+        assert value(0x1800, 1) == 0x40000180 + axis.node_id and value(0x1800, 2) == 1  # every SYNC
         for index in (0x1401, 0x1402, 0x1403, 0x1801, 0x1802, 0x1803):
-            assert node.value(index, 1) & 0x80000000, f"{axis.name}: 0x{index:04X} should be off"
+            assert value(index, 1) & 0x80000000, f"{axis.name}: 0x{index:04X} should be off"
 
 
 def test_tpdo1_is_remapped_in_the_cia_301_order(booted):
@@ -34,21 +35,26 @@ def test_tpdo1_is_remapped_in_the_cia_301_order(booted):
     ]
 
 
-def test_a_mapping_that_reads_back_different_stops_the_boot(make_rig):
-    rig = make_rig()
-    node = rig.drive("tendon2").node
+def map_following_error_for_position(drives, name: str) -> None:
+    """In the drives' process: drive `name` puts following error actual (0x60F4) where position
+    actual is asked for in its TPDO1 mapping."""
+    node = drives.drive(name).node
     store = node.set_data
 
     def maps_something_else(index, subindex, data, check_writable=False):
-        """A drive that puts following error actual (0x60F4) where position actual was asked for."""
         if (index, subindex) == (0x1A00, 2):
             data = (0x60F40020).to_bytes(4, "little")
         store(index, subindex, data, check_writable)
 
     node.set_data = maps_something_else
+
+
+def test_a_mapping_that_reads_back_different_stops_the_boot(make_rig):
+    rig = make_rig()
+    rig.in_drives(map_following_error_for_position, "tendon2")
     with pytest.raises(ReadBackMismatch) as error:
         rig.testbed.boot()
     message = str(error.value)
     assert error.value.axis == "tendon2"
     assert "TPDO1 mapping entry 2 0x1A00:02 reads back 0x60F40020, expected 0x60640020" in message
-    assert rig.drive("tendon2").nmt_state == "PRE-OPERATIONAL"   # never started
+    assert rig.nmt_states()["tendon2"] == "PRE-OPERATIONAL"   # never started

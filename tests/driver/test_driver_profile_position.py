@@ -16,7 +16,7 @@ def test_a_point_move_reaches_every_target_within_the_position_window(homed):
     homed.testbed.move_to(targets)
     reached = homed.testbed.positions()
     assert reached.values() == pytest.approx(targets.values(), abs=0.021)  # position window 0.02 mm + 1 count
-    assert [homed.drive(name).position_actual_mm for name in ("tendon1", "insertion")] == pytest.approx(
+    assert [homed.position_actual_mm(name) for name in ("tendon1", "insertion")] == pytest.approx(
         [3.0 + homed.config.coordination.pretension_mm, 35.0], abs=0.021)
 
 
@@ -42,7 +42,7 @@ def test_the_slowest_axis_runs_at_its_limit_and_the_others_in_proportion(homed):
     homed.testbed.move_to(homed.testbed.targets_from_pulls(-5.0, 5.0, 60.0))
     insertion, tendon1 = homed.config.insertion_axis, homed.config.axis("tendon1")
     distance_mm = 60.0 - homed.testbed.axes["insertion"].config.home_position_mm
-    profile_counts_s = {name: homed.drive(name).node.value(0x6081) for name in ("tendon1", "insertion")}
+    profile_counts_s = {name: homed.object_value(name, 0x6081) for name in ("tendon1", "insertion")}
     assert profile_counts_s["insertion"] == round(insertion.max_velocity_mm_s * insertion.counts_per_mm)
     assert tendon1.counts_to_mm(profile_counts_s["tendon1"]) == pytest.approx(
         insertion.max_velocity_mm_s * 5.0 / distance_mm, rel=0.01)
@@ -87,7 +87,7 @@ def test_halt_is_set_from_enable_until_a_target_is_given(booted):
         booted.testbed.cycle()
     enabled = [command for f in booted.frames() if (command := rpdo1(f, node)) and command[0] & 0x0F == 0x0F]
     assert enabled and all(controlword == 0x010F for controlword, _ in enabled)
-    assert booted.drive("tendon2").position_actual_mm == 0.0                      # nothing moved
+    assert booted.position_actual_mm("tendon2") == 0.0                      # nothing moved
 
 
 def test_a_target_outside_the_soft_limits_is_refused_before_anything_moves(homed):
@@ -117,5 +117,5 @@ def test_jogging_replaces_the_target_on_the_way(homed):
     assert testbed.positions().pulls_mm[0] == pytest.approx(-1.0, abs=0.02)
     tendon1 = homed.config.axis("tendon1")
     cap_mm_s = 0.25 * tendon1.max_velocity_mm_s                                      # the jog speed cap
-    assert homed.drive("tendon1").node.value(0x6081) == round(cap_mm_s * tendon1.counts_per_mm)
+    assert homed.object_value("tendon1", 0x6081) == round(cap_mm_s * tendon1.counts_per_mm)
     assert max(speeds) <= cap_mm_s * 1.05   # the servo catching up its lag after the reversal

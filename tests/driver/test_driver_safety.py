@@ -3,7 +3,8 @@
 Each case runs a cyclic synchronous trajectory on a homed testbed and breaks something in the
 middle of it. Afterwards every drive must be in QUICK STOP ACTIVE, SWITCH ON DISABLED or FAULT,
 the quick stop must have reached every drive before the next SYNC, and the stop callback (the
-log flush) must have run once with the stop.
+log flush) must have run once with the stop. The drives run in a process of their own
+(driver_rig.py), as they do behind `crest testbed serve`.
 """
 
 import math
@@ -67,7 +68,7 @@ def assert_all_stopped(rig) -> None:
 
 
 def test_emcy_stops_every_axis_within_one_sync(homed):
-    stop = run_until_stopped(homed, lambda: homed.drive("tendon3").inject_fault(FaultKind.EMCY))
+    stop = run_until_stopped(homed, lambda: homed.inject_fault("tendon3", FaultKind.EMCY))
     assert (stop.exit_code, stop.axis) == (ExitCode.EMCY, "tendon3")
     assert "EMCY 0x2310 (continuous over current)" in str(stop)
     frames = homed.frames()
@@ -89,7 +90,7 @@ def test_an_emcy_scheduled_by_fault_spec_stops_the_testbed(make_rig):
 
 
 def test_heartbeat_loss_of_a_drive_stops_every_axis(homed):
-    stop = run_until_stopped(homed, lambda: homed.drive("tendon4").inject_fault(FaultKind.HEARTBEAT))
+    stop = run_until_stopped(homed, lambda: homed.inject_fault("tendon4", FaultKind.HEARTBEAT))
     assert (stop.exit_code, stop.axis) == (ExitCode.HEARTBEAT_LOST, "tendon4")
     assert "no heartbeat for" in str(stop)
     quick_stop_start(homed)
@@ -101,7 +102,7 @@ def test_heartbeat_loss_of_a_drive_stops_every_axis(homed):
 
 
 def test_a_stalled_motor_is_a_following_error(homed):
-    stop = run_until_stopped(homed, lambda: homed.drive("tendon1").inject_fault(FaultKind.STALL))
+    stop = run_until_stopped(homed, lambda: homed.inject_fault("tendon1", FaultKind.STALL))
     assert (stop.exit_code, stop.axis) == (ExitCode.FOLLOWING_ERROR, "tendon1")
     assert "following error" in str(stop)
     quick_stop_start(homed)
@@ -109,7 +110,7 @@ def test_a_stalled_motor_is_a_following_error(homed):
 
 
 def test_error_frames_stop_every_axis(homed):
-    stop = run_until_stopped(homed, lambda: homed.drive("tendon2").inject_fault(FaultKind.ERROR_FRAMES))
+    stop = run_until_stopped(homed, lambda: homed.inject_fault("tendon2", FaultKind.ERROR_FRAMES))
     assert (stop.exit_code, stop.axis) == (ExitCode.BUS_ERROR, "bus")
     frames = homed.frames()
     error_frame = next(i for i, f in enumerate(frames) if f.is_error_frame)
@@ -118,7 +119,7 @@ def test_error_frames_stop_every_axis(homed):
 
 
 def test_a_drive_that_stops_answering_sdo_stops_every_axis(homed):
-    homed.drive("tendon3").inject_fault(FaultKind.SDO_TIMEOUT)
+    homed.inject_fault("tendon3", FaultKind.SDO_TIMEOUT)
     stops = []
     homed.testbed.on_safety_stop(stops.append)
     with pytest.raises(SafetyStop) as stop:
@@ -132,7 +133,7 @@ def test_a_drive_that_stops_answering_sdo_stops_every_axis(homed):
 
 def test_tension_above_the_limit_stops_every_axis_before_the_next_sync(homed):
     tendon2 = homed.config.axis("tendon2")
-    stop = run_until_stopped(homed, lambda: homed.drive("tendon2").set_load_tension_n(45.0))
+    stop = run_until_stopped(homed, lambda: homed.set_load_tension_n("tendon2", 45.0))
     assert (stop.exit_code, stop.axis) == (ExitCode.TENSION_LIMIT, "tendon2")
     assert "tension 45.0 N exceeds max_tension_n 40 N" in str(stop)
     frames = homed.frames()
@@ -196,12 +197,12 @@ def test_an_exception_in_a_with_block_stops_every_axis(homed, error, exit_code):
 
 
 def test_emergency_stop_over_a_second_bus_handle_stops_every_axis(homed):
-    """In one process: emergency_stop() on a second handle of the rig's bus, as `crest estop` uses
-    it on a hardware bus. The command itself, from another process, is tested in tests/cli."""
+    """emergency_stop() on a second client of the rig's bus (the drives are in their own process),
+    as `crest estop` uses it. The command itself, from another process, is tested in tests/cli."""
     homed.testbed.jog_to(homed.testbed.targets_from_pulls(5.0, 0.0, 40.0))
     for _ in range(10):
         homed.testbed.cycle()
-    other_bus = can.Bus(interface="virtual", channel=homed.channel)
+    other_bus = homed.open_bus()
     try:
         outcome = emergency_stop(other_bus, homed.config)
     finally:
@@ -216,8 +217,8 @@ def test_emergency_stop_over_a_second_bus_handle_stops_every_axis(homed):
 def test_emergency_stop_tries_every_axis_and_reports_the_one_it_could_not_reach(make_rig):
     rig = make_rig(config=make_config(sdo_timeout_s=0.2))   # the timeout is expected to expire
     rig.testbed.boot()
-    rig.drive("tendon3").inject_fault(FaultKind.SDO_TIMEOUT)
-    other_bus = can.Bus(interface="virtual", channel=rig.channel)
+    rig.inject_fault("tendon3", FaultKind.SDO_TIMEOUT)
+    other_bus = rig.open_bus()
     try:
         outcome = emergency_stop(other_bus, rig.config)
     finally:
@@ -238,8 +239,8 @@ def test_a_drive_that_does_not_answer_delays_no_other_axis_quick_stop(make_rig):
     timeout, every other axis' quick stop is on the bus before that timeout ends and each is stopped."""
     rig = make_rig(config=make_config(sdo_timeout_s=SILENT_AXIS_TIMEOUT_S))   # expected to expire
     rig.testbed.boot()
-    rig.drive("tendon1").inject_fault(FaultKind.SDO_TIMEOUT)
-    other_bus = can.Bus(interface="virtual", channel=rig.channel)
+    rig.inject_fault("tendon1", FaultKind.SDO_TIMEOUT)
+    other_bus = rig.open_bus()
     start_s = time.time()
     try:
         outcome = emergency_stop(other_bus, rig.config)
@@ -263,23 +264,23 @@ def test_a_dead_host_stops_the_testbed(homed):
     for _ in range(10):
         testbed.cycle()
     assert set(homed.drive_states().values()) == {"OPERATION_ENABLED"}
-    moving_mm = homed.drive("insertion").position_actual_mm
+    moving_mm = homed.position_actual_mm("insertion")
     start = len(homed.frames())
     for _ in range(30):                                  # 0.3 s > heartbeat_timeout_s 0.25 s
         homed.advance(0.01)
     assert set(homed.drive_states().values()) == {"FAULT"}
-    assert all(0x8130 in drive.active_error_codes for drive in homed.drives.drives.values())
+    assert all(0x8130 in homed.active_error_codes(name) for name in homed.drive_names)
     emcys = {f.arbitration_id for f in homed.frames()[start:] if bytes(f.data[:2]) == b"\x30\x81"}
     assert emcys == {0x80 + axis.node_id for axis in homed.config.axes}
     # Someone else's SYNC would drive the motion on: the faulted drives do not move.
-    stranger = can.Bus(interface="virtual", channel=homed.channel)
+    stranger = homed.open_bus()
     try:
         for _ in range(5):
             stranger.send(can.Message(arbitration_id=0x80, data=b"", is_extended_id=False))
         homed.frames()
     finally:
         stranger.shutdown()
-    assert homed.drive("insertion").position_actual_mm == moving_mm
+    assert homed.position_actual_mm("insertion") == moving_mm
     assert moving_mm < 59.0
     # A host that was only hung, not dead, learns of it from the drives' EMCY 0x8130.
     with pytest.raises(SafetyStop) as stop:
@@ -287,17 +288,21 @@ def test_a_dead_host_stops_the_testbed(homed):
     assert stop.value.exit_code == ExitCode.HEARTBEAT_LOST and "0x8130" in str(stop.value)
 
 
+def lose_emcys(drives, name: str) -> None:
+    """In the drives' process: the EMCY frames of drive `name` get lost."""
+    drives.drive(name)._emcy = lambda code, register: None
+
+
 def test_a_drive_fault_without_emcy_is_reset_on_a_rising_edge_when_enabling(booted):
-    drive = booted.drive("tendon1")
-    drive._emcy = lambda code, register: None          # a drive whose EMCY got lost
-    drive.inject_fault(FaultKind.EMCY)
+    booted.in_drives(lose_emcys, "tendon1")
+    booted.inject_fault("tendon1", FaultKind.EMCY)
     booted.testbed.cycle()
     assert booted.testbed.axes["tendon1"].state is Cia402State.FAULT
     booted.testbed.enable()
     words = [c[0] for f in booted.frames() if (c := rpdo1(f, 1))]
     distinct = [w for i, w in enumerate(words) if i == 0 or w != words[i - 1]]
     assert distinct == [0x0000, 0x0080, 0x0006, 0x0007, 0x010F]   # bit 7 low, then high: one rising edge
-    assert drive.state.name == "OPERATION_ENABLED"
+    assert booted.drive_states()["tendon1"] == "OPERATION_ENABLED"
 
 
 def test_close_disables_every_axis_and_stops_the_drives_watching_the_host(homed):
@@ -306,4 +311,4 @@ def test_close_disables_every_axis_and_stops_the_drives_watching_the_host(homed)
     for _ in range(40):
         homed.advance(0.01)                              # longer than the heartbeat timeout
     assert set(homed.drive_states().values()) == {"SWITCH_ON_DISABLED"}
-    assert {drive.nmt_state for drive in homed.drives.drives.values()} == {"PRE-OPERATIONAL"}
+    assert set(homed.nmt_states().values()) == {"PRE-OPERATIONAL"}

@@ -95,3 +95,17 @@ def test_a_second_fast_run_beside_one_that_drives_its_testbed_keeps_its_testbed_
     assert first.poll() is None and json.loads(state_file.read_text())["pid"] == testbed_pid
     rows = rows_on_disk(first_log)
     wait_for_rows(first_log, rows + 20, first)                         # the first run goes on
+
+
+def test_a_fault_lands_at_the_same_simulated_time_across_the_boundary_as_inside_one_process(tmp_path):
+    """The fault clock starts on the bus in order with the TIME stamps, and the testbed compares
+    times in whole microseconds: a `--fault` stops the run on the same cycle either way."""
+    logs = {}
+    for mode in ("process", "in-process"):
+        logs[mode] = tmp_path / f"{mode}.csv"
+        result = crest("run", "builtin:sweep", "--fast", "--fault", "tendon3:emcy@0.5", "--record", str(logs[mode]),
+                       env={"CREST_VIRTUAL_TESTBED": mode})
+        assert result.returncode == ExitCode.EMCY, result.stderr
+    assert time_stamps_s(logs["process"].with_suffix(".blf"))          # that run crossed the boundary
+    across, inside = (read_log(logs[mode]).t_s for mode in ("process", "in-process"))
+    assert list(across) == list(inside) and 0.45 <= across[-1] < 0.5

@@ -1,5 +1,7 @@
 """Parsing of ``--fault AXIS:KIND@SECONDS``."""
 
+import itertools
+
 import pytest
 
 from sim_backend.faults import FaultKind, FaultSchedule, FaultSpec, parse_fault
@@ -52,3 +54,19 @@ def test_schedule_hands_out_each_fault_once_in_time_order():
     assert schedule.due(5.0) == [late]
     assert schedule.due(6.0) == []
     assert schedule.pending == ()
+
+
+def test_a_fault_is_due_on_the_same_step_whether_the_time_is_a_sum_of_steps_or_a_stamps_milliseconds():
+    """Inside one process the time is a stepped clock's float sum of 10 ms steps; across the process
+    boundary it is a TIME stamp's whole milliseconds. A fault 0.5 s after a clock started at step
+    688 is due at step 738 both ways (the float difference of those sums is 0.4999999999...)."""
+    summed_s = list(itertools.accumulate([0.01] * 800, initial=0.0))
+    stamped_s = [round(t_s * 1000.0) / 1000.0 for t_s in summed_s]
+
+    def due_step(times_s):
+        schedule = FaultSchedule([parse_fault("tendon3:emcy@0.5")], held=True)
+        schedule.start_clock(times_s[688])
+        return next(step for step, t_s in enumerate(times_s) if schedule.due(t_s))
+
+    assert summed_s[738] - summed_s[688] < 0.5
+    assert due_step(summed_s) == due_step(stamped_s) == 738

@@ -93,6 +93,17 @@ def test_heartbeat_producer_runs_on_tick_with_the_nmt_state(bench):
     assert bytes(bench.recorder.with_id(0x701)[1].data) == bytes([0x04])
 
 
+def test_a_heartbeat_is_due_after_one_period_when_the_time_is_a_stamps_whole_milliseconds(bench):
+    """Across the process boundary the drives' time comes in a TIME stamp's whole milliseconds:
+    0.06 - 0.01 is 0.04999999999999999 as floats, yet 50 ms have passed."""
+    bench.barrier()
+    bench.tick(0.01)
+    bench.barrier()
+    bench.recorder.clear()
+    bench.tick(0.06)
+    bench.recorder.wait_for(lambda frames: bench.recorder.with_id(0x701), "heartbeat of node 1 at 0.06 s")
+
+
 def test_stopped_drive_answers_no_sdo_and_sends_no_pdo(bench):
     from canopen.sdo import SdoCommunicationError
     node = bench.nodes["tendon1"]
