@@ -361,6 +361,7 @@ def run_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Excitat
            "baseline_holdout_rmse_mm": result["baseline"]["holdout_rmse_mm"],
            "model_form_rms_mm": verdict["model_form_rms_mm"], "predicted_shrink": verdict["shrink"],
            "top_candidates": [c["effect"] for c in result["candidates"][:3]],
+           "candidates": [candidate_summary(c) for c in result["candidates"]],
            "record_seconds": recorded - start, "seconds": seconds, "timing_s": result["timing_s"],
            "slowest_candidate": max(result["candidates"], key=lambda c: c["seconds"])["effect"]}
     if case.family == "dahl" and case.effects:
@@ -384,6 +385,16 @@ def run_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Excitat
     if "oracle_shrink" in row and math.isfinite(row["oracle_shrink"]):
         row["shrink_error_pp"] = 100.0 * abs(verdict["shrink"] - row["oracle_shrink"])
     return row
+
+
+def candidate_summary(candidate: dict) -> dict:
+    """What a case's row keeps of each single candidate of its diagnosis, so that a miss can be
+    studied from the benchmark's JSON: its shrink on the selection half, whether it was found,
+    why not, and its gain's concentration in its signature region."""
+    return {"effect": candidate["effect"], "selection_shrink": candidate["selection_shrink"],
+            "found": candidate["found"], "rejected": candidate["rejected"],
+            "signature_concentration": candidate["signature_concentration"]["concentration"],
+            "params": candidate["params"]}
 
 
 def detection_curve(rows: list[dict]) -> dict[str, list[dict]]:

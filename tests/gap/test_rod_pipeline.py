@@ -9,6 +9,7 @@ from pathlib import Path
 
 from crest.config import load_testbed_config
 from crest.experiment.excitation_run import plan_excitation, record_excitation
+from crest.gap.blind_benchmark import candidate_summary
 from crest.gap.log_diagnosis import diagnose_logs
 from crest.session import SessionOptions, open_session
 from model import CatheterParams
@@ -64,6 +65,9 @@ def test_rod_without_effects_names_no_catalog_effect_and_describes_the_model_for
     assert verdict["rejected"] and all(row["reasons"] for row in verdict["rejected"])
     assert verdict["residual"], "where the residual lies and its signature"
     assert {c["effect"] for c in result["candidates"]} == set(EFFECTS)
+    kept = [candidate_summary(c) for c in result["candidates"]]     # what a blind benchmark row keeps
+    assert all(not row["found"] and row["rejected"] for row in kept)
+    assert [row["selection_shrink"] for row in kept] == [c["selection_shrink"] for c in result["candidates"]]
 
 
 def test_rod_behind_a_tracker_too_noisy_to_resolve_its_model_form_gives_none():
