@@ -2,7 +2,7 @@
 
 The same circle runs three times on the virtual testbed, through the same controller: once with no
 view, once with the view's server running and no page open (its cost inside the process), once
-with the live view serving a headless Chromium that draws the page at its 30 Hz (without a browser
+with the live view serving a headless Chromium that draws the page at its 10 Hz (without a browser
 on this machine: no page open again, and the result says so; the browser's own drawing competes
 for the same CPU cores). The cycle time is the wall time between consecutive control cycles, taken in the loop's own
 on_cycle callback. In simulated time (the default) the loop runs back to back, so the cycle time

@@ -11,7 +11,8 @@ process, `model.gap.fit_pool`), see `local_executor`.
 `open_executor("tcp://HOST:PORT")`: the executor of a `distributed.Client` connected to a running
 Dask scheduler (`Client.get_executor`; the scheduler and its workers are started with `dask
 scheduler` and `dask worker`, and the workers must be able to import this project). The address is
-checked and the scheduler reached, with a worker, before any work starts. On leaving the context,
+checked and the scheduler reached, with a worker, before any work starts (an address where nothing
+listens is refused at once; dask's client would retry it for its whole timeout). On leaving the context,
 however it is left (Ctrl-C, SIGTERM, an error), every task still pending or running is cancelled
 and the client is closed, so nothing is left on the cluster. Dask is imported here only: `model`
 sees an Executor.
@@ -20,6 +21,7 @@ from __future__ import annotations
 
 import multiprocessing
 import re
+import socket
 from collections.abc import Iterator
 from concurrent.futures import Executor
 from contextlib import contextmanager
@@ -80,16 +82,17 @@ def local_executor(workers: int) -> Iterator[Executor | None]:
 def dask_executor(address: str) -> Iterator[Executor]:
     """The executor of a Dask client connected to the scheduler at `address` (tcp://HOST:PORT); its
     tasks are cancelled and the client closed on leaving, normally or not."""
-    check_scheduler_address(address)
+    match = ADDRESS.fullmatch(check_scheduler_address(address))
+    try:
+        socket.create_connection((match["host"], int(match["port"])), timeout=CONNECT_TIMEOUT_S).close()
+    except OSError as error:
+        raise _no_scheduler(address, error) from None
     from distributed import Client     # only the cluster path needs dask
 
     try:
         client = Client(address, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
     except (OSError, TimeoutError) as error:
-        raise SchedulerError(f"--scheduler {address}: no Dask scheduler answers there within "
-                             f"{CONNECT_TIMEOUT_S:.0f} s ({error}); start one with `dask scheduler --host 127.0.0.1 "
-                             f"--port PORT` and a worker with `dask worker {address}`, or leave out --scheduler to "
-                             "run on local processes") from None
+        raise _no_scheduler(address, error) from None
     executor = None
     try:
         try:
@@ -104,3 +107,9 @@ def dask_executor(address: str) -> Iterator[Executor]:
         if executor is not None:
             executor.shutdown(wait=False)            # cancels the tasks still pending or running
         client.close()
+
+
+def _no_scheduler(address: str, error: Exception) -> SchedulerError:
+    return SchedulerError(f"--scheduler {address}: no Dask scheduler answers there within {CONNECT_TIMEOUT_S:.0f} s "
+                          f"({error}); start one with `dask scheduler --host 127.0.0.1 --port PORT` and a worker with "
+                          f"`dask worker {address}`, or leave out --scheduler to run on local processes")

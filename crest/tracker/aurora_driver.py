@@ -274,7 +274,7 @@ class AuroraDriver:
         port.timeout = timeout_s
         port.reset_input_buffer()  # leftovers of an earlier failed exchange
         port.write(reply.with_crc(command))
-        raw = port.read_until(b"\r", _MAX_REPLY_BYTES)
+        raw = _read_reply(port, timeout_s)
         if not raw.endswith(b"\r"):
             raise TrackerLinkError(f"no reply to {command} within {timeout_s} s (got {raw[:40]!r})")
         return raw
@@ -376,6 +376,22 @@ class AuroraDriver:
         _log.info("tracker on %s: %s (%s)", self.port, state.value, reason)
         if self.on_state is not None:
             self.on_state(state, reason)
+
+
+def _read_reply(port: serial.Serial, timeout_s: float) -> bytes:
+    """The reply on ``port`` up to and including its CR (at most _MAX_REPLY_BYTES; shorter, without
+    the CR, once ``timeout_s`` has passed). Takes what has arrived in one read, where pyserial's
+    read_until reads byte by byte (a one-tool TX reply is 81 bytes); anything after the CR is dropped,
+    as the next command's reset_input_buffer would drop it."""
+    raw = bytearray()
+    deadline_s = time.monotonic() + timeout_s
+    while b"\r" not in raw and len(raw) < _MAX_REPLY_BYTES:
+        chunk = port.read(max(1, min(port.in_waiting, _MAX_REPLY_BYTES - len(raw))))
+        raw += chunk
+        if not chunk or time.monotonic() > deadline_s:
+            break
+    end = raw.find(b"\r")
+    return bytes(raw if end < 0 else raw[:end + 1])
 
 
 def _bump(stats: TrackerStats, **flags: bool) -> TrackerStats:

@@ -13,7 +13,7 @@ from collections import deque
 from crest.driver import CycleSample
 
 DEFAULT_CAPACITY = 1024
-"""Cycles kept for the view: over 2 s at 500 Hz SYNC, far more than one 30 Hz screen frame needs."""
+"""Cycles kept for the view: over 2 s at 500 Hz SYNC, far more than one 10 Hz screen frame needs."""
 
 
 class SampleSlot:
