@@ -12,13 +12,14 @@ import sys
 import time
 
 import can
+import numpy as np
 import pytest
 
 from crest.exit_codes import ExitCode
 from crest.log import read_log
 from served_testbed import (HEARTBEAT_TIMEOUT_S, crest_lines, rows_on_disk, start_run, start_served_testbed,
                             status_rows, stop, wait_for_rows)
-from tests.cli.cli_runner import REPO
+from tests.cli.cli_runner import REPO, crest
 
 AXES = ("tendon1", "tendon2", "tendon3", "tendon4", "insertion")
 NODE_IDS = (1, 2, 3, 4, 5)
@@ -129,3 +130,27 @@ def test_kill_9_of_the_served_testbed_stops_the_run_on_every_axis_heartbeat_lost
     summary = json.loads(log_path.with_suffix(".json").read_text())["summary"]
     assert summary["exit_code"] == ExitCode.HEARTBEAT_LOST and summary["stop_cause"] in lines[0]
     assert len(read_log(log_path)) >= 20
+
+
+def test_a_configuration_whose_bus_and_tracker_name_the_served_testbed_runs_on_it_as_on_hardware(served, tmp_path):
+    """[bus] names python-can's `remote` interface and the served bus, [tracker].port its pseudo-
+    terminal: a command opens both as it opens a hardware bus and a serial tracker. Its runtime
+    folder holds no state file, so the configuration alone takes it there."""
+    text = served.config.read_text()
+    for key, value in (("interface", "remote"), ("channel", served.state["bus_channel"]),
+                       ("port", served.state["tracker_port"])):
+        text, count = re.subn(rf'^{key} = "[^"]*"', f'{key} = "{value}"', text, count=1, flags=re.MULTILINE)
+        assert count == 1, key
+    hardware = tmp_path / "hardware"
+    hardware.mkdir()
+    (hardware / "crest_drive.eds").write_text((served.config.parent / "crest_drive.eds").read_text())
+    (hardware / "testbed.toml").write_text(text)
+    runtime = tmp_path / "no_state_file"
+    runtime.mkdir(mode=0o700)
+    log_path = tmp_path / "run.csv"
+    run = crest("run", "builtin:circle", "--insertion-mm", "25", "--periods", "1", "--config",
+                str(hardware / "testbed.toml"), "--record", str(log_path), env={"XDG_RUNTIME_DIR": str(runtime)})
+    assert run.returncode == ExitCode.OK, run.stderr
+    assert served.process.poll() is None and not (runtime / "crest").exists()   # it joined, started nothing
+    log = read_log(log_path)
+    assert len(log) > 1000 and np.isfinite(log.tip_mm).all(axis=1).sum() > 100    # tips from the served tracker
