@@ -106,9 +106,9 @@ class FaultSchedule:
     """Faults waiting for their time; ``due(now_s)`` hands each one out once.
 
     A fault at ``at_s`` is due when ``now_s - clock_zero_s >= at_s`` (in whole microseconds,
-    sim_backend.sim_time). The clock starts at 0 (the
-    testbed's start) unless the schedule is ``held``: then nothing is due until ``start_clock(now_s)``
-    sets ``clock_zero_s = now_s`` (once; later calls keep the first zero).
+    sim_backend.sim_time). The clock starts at 0 (the testbed's start) unless the schedule is
+    ``held``: then nothing is due until ``start_clock(now_s)`` sets ``clock_zero_s = now_s`` (once;
+    later calls keep the first zero).
     """
 
     def __init__(self, faults: tuple[FaultSpec, ...] | list[FaultSpec], held: bool = False) -> None:
@@ -123,8 +123,10 @@ class FaultSchedule:
         if self._clock_zero_s is None:
             return []
         elapsed_us = whole_us(now_s - self._clock_zero_s)
-        ready = [fault for fault in self._waiting if whole_us(fault.at_s) <= elapsed_us]
-        self._waiting = [fault for fault in self._waiting if whole_us(fault.at_s) > elapsed_us]
+        count = 0                     # the waiting faults are sorted by time: the due ones lead
+        while count < len(self._waiting) and whole_us(self._waiting[count].at_s) <= elapsed_us:
+            count += 1
+        ready, self._waiting = self._waiting[:count], self._waiting[count:]
         return ready
 
     @property

@@ -67,7 +67,6 @@ def test_rod_without_effects_names_no_catalog_effect_and_describes_the_model_for
     assert {c["effect"] for c in result["candidates"]} == set(EFFECTS)
     kept = [candidate_summary(c) for c in result["candidates"]]     # what a blind benchmark row keeps
     assert all(not row["found"] and row["rejected"] for row in kept)
-    assert [row["selection_shrink"] for row in kept] == [c["selection_shrink"] for c in result["candidates"]]
 
 
 def test_rod_behind_a_tracker_too_noisy_to_resolve_its_model_form_gives_none():
