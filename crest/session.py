@@ -14,6 +14,7 @@ from crest.backend import Backend, open_backend
 from crest.config import TestbedConfig, load_testbed_config
 from crest.driver import MonotonicClock, SteppedClock, Testbed
 from crest.experiment.tip_feed import TipFeed
+from crest.testbed_service.cpu_split import beside
 from crest.tracker import AuroraDriver
 
 TRACKER_RATE_HZ = 40.0          # the Aurora's sample rate
@@ -72,6 +73,8 @@ def open_session(options: SessionOptions = SessionOptions()) -> Iterator[Session
                            tracker_dropout=options.tracker_dropout)
     with ExitStack() as stack:
         stack.callback(backend.close)
+        if backend.served is not None:
+            stack.enter_context(beside(backend.served.cpus))
         clock = MonotonicClock() if options.realtime else SteppedClock(on_advance=backend.tick)
         testbed = Testbed(backend.bus, config, clock=clock)
         tracker = None

@@ -21,9 +21,12 @@ class Controller(ABC):
     when available. Open-loop controllers ignore both. Returns the TendonCommand to send.
     reset(insertion_mm): forget all history; the catheter is straight and unloaded, tendons at
     0 mm, at this free length (default: the workspace's home free length).
+    uses_feedback: False when the command ignores `tip` and `drive_tension_n`; the run loop
+    then computes the next command while the drives answer the current SYNC.
     """
 
     name: str
+    uses_feedback: bool = False
 
     @abstractmethod
     def command(self, setpoint: SetPoint, tip: TipMeasurement | None = None,

@@ -32,6 +32,7 @@ class DahlFeedback(Controller):
     [tracker].loss_timeout_s. The command's predicted_tip_mm is the estimator's prediction."""
 
     name = "dahl+fb"
+    uses_feedback = True
 
     def __init__(self, workspace: Workspace, limits: MotionLimits = MotionLimits(), period_s: float = 0.01, *,
                  n_elements: int = 20, loss_timeout_s: float = 0.25, estimator: TipEstimator | None = None,

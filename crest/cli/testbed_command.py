@@ -77,6 +77,8 @@ def _announce(served, state_file: Path) -> None:
           f"  CAN bus:    python-can interface '{served.bus_interface}', channel '{served.bus_channel}'\n"
           f"  tracker:    {served.tracker_port}\n"
           f"  state file: {state_file}\n"
+          + (f"  CPU:        {', '.join(map(str, served.cpus))} (the commands that join it run on the others)\n"
+             if served.cpus else "")
           + ("  clock:      simulated: it moves only with the TIME stamps of a command run with --fast\n"
              if served.simulated_time else "")
           + "Other crest commands on this configuration join it now. Stop it with Ctrl-C "

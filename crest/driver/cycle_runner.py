@@ -89,12 +89,13 @@ class CycleRunner:
                                 for axis in self.axes)
 
     # --- cycles ------------------------------------------------------------------------------
-    def cycle(self, limited: Sequence[str] = ()) -> CycleSample:
-        """One supervised SYNC cycle; SafetyStop if the testbed is (or gets) stopped."""
+    def cycle(self, limited: Sequence[str] = (), meanwhile: Callable[[], None] | None = None) -> CycleSample:
+        """One supervised SYNC cycle (``meanwhile``: see SyncCycle.run); SafetyStop if the testbed
+        is (or gets) stopped."""
         self.raise_if_stopped()
         latched = [axis.sent_target_counts if axis.mode is OperationMode.CYCLIC_SYNC_POSITION else None
                    for axis in self.axes]
-        now_s, fresh = self.sync.run()
+        now_s, fresh = self.sync.run(meanwhile)
         if self.monitor.armed:
             self._check(now_s, fresh, latched)
         self.raise_if_stopped()

@@ -4,7 +4,8 @@ The cycle is paced by the driver's clock at the configured SYNC period (CiA 301 
 0x80, no counter byte). The drives latch the set-points at the SYNC and answer it with their
 TPDO1, sampled at that SYNC; ``run`` returns when every drive has answered or the reply time
 has passed (a drive that did not answer is marked not fresh, its heartbeat decides whether it
-is lost).
+is lost). Work that does not need this SYNC's replies (``meanwhile``, e.g. the next set-point of
+a feedforward controller) runs after the SYNC is sent, while the drives answer it.
 
 ``quick_stop_all`` may be called from any thread: under the send lock it replaces every
 controlword by quick stop, sends it to every drive at once, and keeps sending it in every
@@ -14,7 +15,7 @@ later cycle.
 from __future__ import annotations
 
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import can
 import canopen
@@ -53,8 +54,9 @@ class SyncCycle:
     def started(self) -> bool:
         return self.next_sync_s is not None
 
-    def run(self) -> tuple[float, tuple[bool, ...]]:
-        """Wait for the SYNC time, send, wait for the replies; (SYNC time s, fresh TPDO1 per axis)."""
+    def run(self, meanwhile: Callable[[], None] | None = None) -> tuple[float, tuple[bool, ...]]:
+        """Wait for the SYNC time, send, call ``meanwhile``, wait for the replies; (SYNC time s,
+        fresh TPDO1 per axis)."""
         if self.next_sync_s is None:
             self.next_sync_s = self._clock.now_s()
         self._clock.wait_until(self.next_sync_s)
@@ -69,6 +71,8 @@ class SyncCycle:
                 axis.sent_target_counts = axis.target_counts
             self._network.send_message(SYNC_COB_ID, b"")
         self.count += 1
+        if meanwhile is not None:
+            meanwhile()
         with self._feedback_changed:
             self._feedback_changed.wait_for(
                 lambda: all(axis.tpdo_count > mark for axis, mark in zip(self.axes, marks)),

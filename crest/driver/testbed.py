@@ -260,13 +260,15 @@ class Testbed:
             self._hand_over(targets, speed_fraction)
             return self._runner.last_sample
 
-    def cycle(self, targets: AxisTargets | None = None) -> CycleSample:
+    def cycle(self, targets: AxisTargets | None = None, *,
+              meanwhile: Callable[[], None] | None = None) -> CycleSample:
         """One SYNC cycle. With ``targets``: cyclic synchronous position set-points (clamped into
-        the limits, see CycleSample.limited); without: the axes keep their current command."""
+        the limits, see CycleSample.limited); without: the axes keep their current command.
+        ``meanwhile`` runs once the SYNC is sent, while the drives answer it."""
         with self._guarded():
             if targets is None:
-                return self._runner.cycle()
-            return self._stream(targets)
+                return self._runner.cycle(meanwhile=meanwhile)
+            return self._stream(targets, meanwhile)
 
     def hold(self, duration_s: float) -> CycleSample:
         """Keep cycling for ``duration_s`` (clock time) with the current commands.
@@ -367,7 +369,7 @@ class Testbed:
         profile_position.wait_reached(self._runner, self._axis_list, duration_s)
         return self._runner.last_sample
 
-    def _stream(self, targets: AxisTargets) -> CycleSample:
+    def _stream(self, targets: AxisTargets, meanwhile: Callable[[], None] | None = None) -> CycleSample:
         self._ensure_enabled()
         if any(axis.mode is not OperationMode.CYCLIC_SYNC_POSITION for axis in self._axis_list):
             state_control.switch_mode(self._runner, self._axis_list, OperationMode.CYCLIC_SYNC_POSITION)
@@ -380,4 +382,4 @@ class Testbed:
                 limited.append(message)
             axis.target_counts = axis.config.mm_to_counts(set_point_mm)
             axis.command(cia402.ENABLE_OPERATION, halt=False)
-        return self._runner.cycle(limited)
+        return self._runner.cycle(limited, meanwhile)

@@ -12,6 +12,9 @@ byte on the pipe starts the fault clock in real time (in simulated time a frame 
 sim_backend.time_stamps): the command's --fault times count from its motion's start, as they do
 with the testbed inside the command. A testbed served on its own has no such
 command, and its fault times count from its start.
+
+Where the machine lets it use two CPUs or more, the testbed runs on the last one, and the commands
+that join it on the others (cpu_split.py).
 """
 from __future__ import annotations
 
@@ -23,6 +26,7 @@ from pathlib import Path
 
 from crest.backend import serve_virtual_testbed
 from crest.config import TestbedConfig
+from crest.testbed_service.cpu_split import pin_process, testbed_cpus
 from crest.testbed_service.state_file import ServedTestbed, claim_serving, config_digest, state_path
 
 
@@ -36,6 +40,9 @@ def serve_until_stopped(config: TestbedConfig, *, plant: str | None = None, plan
     of the starting command's pipe; a byte on it starts the fault clock, its end sends this process
     SIGTERM (see module doc). simulated_time: the testbed's clock moves only with the TIME stamps
     its master sends (sim_backend.time_stamps), not with the wall clock."""
+    cpus = testbed_cpus()
+    if cpus:
+        pin_process(cpus)
     clock_requests = threading.Event()
     if parent_fd is not None:
         threading.Thread(target=_watch_parent, args=(parent_fd, clock_requests), name="parent-pipe",
@@ -51,7 +58,7 @@ def serve_until_stopped(config: TestbedConfig, *, plant: str | None = None, plan
             served = ServedTestbed(pid=os.getpid(), bus_interface=server.bus_interface,
                                    bus_channel=server.bus_channel, tracker_port=server.tracker_port,
                                    config=str(Path(config.path).resolve()), config_digest=config_digest(config),
-                                   simulated_time=simulated_time)
+                                   simulated_time=simulated_time, cpus=cpus)
             publish(served)
             on_ready(served, state_path())
             while True:

@@ -5,6 +5,7 @@ Every run here is a real-time `crest run` in its own process on the served testb
 (python-can interface "remote"); every other command is a process of its own as well.
 """
 import json
+import os
 import re
 import signal
 import subprocess
@@ -154,3 +155,21 @@ def test_a_configuration_whose_bus_and_tracker_name_the_served_testbed_runs_on_i
     assert served.process.poll() is None and not (runtime / "crest").exists()   # it joined, started nothing
     log = read_log(log_path)
     assert len(log) > 20 and np.isfinite(log.tip_mm).all(axis=1).sum() > 5      # tips from the served tracker
+
+
+def thread_cpu_sets(pid: int) -> set[frozenset[int]]:
+    """The CPU masks of every thread of process `pid`."""
+    return {frozenset(os.sched_getaffinity(int(thread))) for thread in os.listdir(f"/proc/{pid}/task")}
+
+
+@pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="with one CPU nothing is pinned")
+def test_the_served_testbed_and_a_run_joined_to_it_run_on_cpus_of_their_own(served, tmp_path):
+    allowed = os.sched_getaffinity(0)
+    testbed_cpus = frozenset(served.state["cpus"])
+    assert testbed_cpus == {max(allowed)}
+    assert thread_cpu_sets(served.state["pid"]) == {testbed_cpus}
+    run = start_run(served, tmp_path / "run.csv")
+    try:
+        assert thread_cpu_sets(run.pid) == {frozenset(allowed - testbed_cpus)}
+    finally:
+        stop(run)
