@@ -12,11 +12,14 @@ each frame a copy and a thread wake-up, so the drives keep none for it.
 duties and fires scheduled per-axis faults; SYNC frames from the client drive
 their motion. SYNC listeners run after every drive has handled a SYNC, in the
 same thread, so a plant stepped there is coupled cycle by cycle: its output
-(``set_load_tension_n``) goes out in the TPDOs of the next SYNC.
+(``set_load_tension_n``) goes out in the TPDOs of the next SYNC. The drives' TPDOs leave before
+those listeners run, so a master can act on a SYNC's answers while the plant still steps for it;
+``wait_sync_handled`` waits that step out (the tracker's sample is taken after it).
 """
 
 from __future__ import annotations
 
+import threading
 from typing import Callable, Iterable, Sequence
 
 import can
@@ -48,6 +51,9 @@ class SimDriveSet:
         self._schedule = FaultSchedule(drive_faults, held=faults_held)
         self._sync_listeners: list[Callable[[int, bytearray, float], None]] = []
         self._network: canopen.Network | None = None
+        self._sync_handled = threading.Condition()
+        self._syncs_begun = 0
+        self._syncs_handled = 0
 
     def drive(self, name: str) -> SimDrive:
         try:
@@ -69,15 +75,31 @@ class SimDriveSet:
         """Send a frame on the drives' bus (from any thread); after ``start``."""
         self._network.send_message(msg.arbitration_id, msg.data)
 
+    def wait_sync_handled(self, timeout_s: float) -> bool:
+        """Wait until the SYNC the drives are handling (if any) is handled to its last listener;
+        False if that took over ``timeout_s`` (e.g. a listener failed)."""
+        with self._sync_handled:
+            return self._sync_handled.wait_for(lambda: self._syncs_handled == self._syncs_begun, timeout_s)
+
+    def _on_sync_begin(self, can_id: int, data: bytearray, timestamp: float) -> None:
+        with self._sync_handled:
+            self._syncs_begun += 1
+
     def _on_sync(self, can_id: int, data: bytearray, timestamp: float) -> None:
-        for listener in self._sync_listeners:
-            listener(can_id, data, timestamp)
+        try:
+            for listener in self._sync_listeners:
+                listener(can_id, data, timestamp)
+        finally:
+            with self._sync_handled:
+                self._syncs_handled = self._syncs_begun
+                self._sync_handled.notify_all()
 
     def start(self) -> None:
         """Open the bus, attach the drives and power them on (each sends its boot-up message)."""
         self._network = canopen.Network(can.Bus(interface="virtual", channel=self.channel))
         self._network.NOTIFIER_CYCLE = NOTIFIER_POLL_S
         self._network.connect()
+        self._network.subscribe(SYNC_COB_ID, self._on_sync_begin)  # before the drives' own SYNC handlers
         for drive in self.drives.values():
             drive.attach(self._network)
         self._network.subscribe(SYNC_COB_ID, self._on_sync)  # after the drives' own SYNC handlers

@@ -6,7 +6,10 @@ port `testbed.tracker_port` exactly as it would open hardware.
 Coupling, on every SYNC (after all drives have advanced one cycle): the tendon and insertion
 drives' actual positions go to the plant; the plant's tendon tensions go back to the tendon
 drives, which report them as torque actual (0x6077) from the next cycle. A plant slower than
-the bus runs in its own thread instead, and the drives use its latest output.
+the bus runs in its own thread instead, and the drives use its latest output. The tracker samples
+the tip once the SYNC being handled has stepped the plant: a master that asks for a frame as soon
+as the drives have answered a SYNC sees the tip of that SYNC, not a race between the two threads
+(so a recording in simulated time gives the same rows every time).
 
 Time: the drives' motion advances by SYNC frames. Time-based duties (heartbeats, watchdogs,
 scheduled faults) advance with `tick(now_s)`: called by the tests with simulated time, by a
@@ -30,6 +33,7 @@ from sim_backend.tracker import SimTracker
 TENDON_AXES = ("tendon1", "tendon2", "tendon3", "tendon4")
 INSERTION_AXIS = "insertion"
 REALTIME_TICK_S = 0.005
+SYNC_HANDLED_TIMEOUT_S = 1.0    # how long a tracker sample waits for the plant's step of a SYNC
 
 
 @dataclass(frozen=True)
@@ -142,6 +146,7 @@ class VirtualTestbed:
             self.drives.drive(name).set_load_tension_n(float(tension))
 
     def _tracker_tip(self):
+        self.drives.wait_sync_handled(SYNC_HANDLED_TIMEOUT_S)
         if self.plant_runner.error is not None:
             return None
         return self.plant_runner.tip_mm()
