@@ -56,12 +56,13 @@ def _cycle_times(duration_s: float, controller_name: str, realtime: bool, *, vie
     stamps: list[float] = []
     with contextlib.ExitStack() as stack:
         shown = stack.enter_context(live_view(view, config, params.tendon_offset_mm, "crest bench"))
+        if browser:     # before the session: a user's browser is not pinned beside the testbed (cpu_split)
+            driver = stack.enter_context(headless_chromium())
+            driver.get(shown.server.url)
         session = stack.enter_context(open_session(SessionOptions(config=config, realtime=realtime, tracker=False)))
         shown.attach(session)
         session.testbed.home()
         if browser:
-            driver = stack.enter_context(headless_chromium())
-            driver.get(shown.server.url)
             session.testbed.hold(PAGE_SETTLE_S)
         on_cycle = shown.follow("bench circle", trajectory.tip_mm, len(trajectory),
                                 lambda _done: stamps.append(time.perf_counter()))
