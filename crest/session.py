@@ -5,7 +5,7 @@ end, Ctrl-C, an exception, a safety stop) leaves every axis stopped and the bus 
 """
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -13,6 +13,7 @@ from pathlib import Path
 from crest.backend import Backend, open_backend
 from crest.config import TestbedConfig, load_testbed_config
 from crest.driver import MonotonicClock, SteppedClock, Testbed
+from crest.driver.realtime_scheduling import Scheduling, realtime_threads
 from crest.experiment.tip_feed import TipFeed
 from crest.testbed_service.cpu_split import beside
 from crest.tracker import AuroraDriver
@@ -27,6 +28,7 @@ class Session:
     testbed: Testbed
     tracker: AuroraDriver | None
     realtime: bool = True
+    scheduling: Scheduling = Scheduling()     # what this process's threads run under
 
     def start_fault_clock(self) -> None:
         """The virtual testbed's --fault times count from now: called where a command's motion
@@ -46,6 +48,8 @@ class SessionOptions:
     the virtual testbed inside this process, on python-can's in-process bus, instead of in a process
     of its own (crest.backend): for callers that reach into the simulator (`backend.virtual`, tests)
     and for data generators that record many logs, where the second process costs CPU.
+    on_notice(line) is told what the operator should know but that stops nothing: a real-time
+    priority (the configuration's [sync] realtime_priority) that the system did not grant.
     """
 
     config_path: Path | None = None
@@ -61,6 +65,7 @@ class SessionOptions:
     tracker_rate_hz: float = TRACKER_RATE_HZ
     tracker_noise_mm: float | None = None     # virtual tracker: overrides configs/virtual_plant.toml
     tracker_dropout: float | None = None
+    on_notice: Callable[[str], None] = lambda line: None
 
 
 @contextmanager
@@ -75,6 +80,11 @@ def open_session(options: SessionOptions = SessionOptions()) -> Iterator[Session
         stack.callback(backend.close)
         if backend.served is not None:
             stack.enter_context(beside(backend.served.cpus))
+        scheduling = Scheduling()
+        if options.realtime:
+            scheduling = stack.enter_context(realtime_threads(config.sync.realtime_priority))
+            if scheduling.refused:
+                options.on_notice(f"{scheduling.refused}; the cycle runs under the normal scheduler")
         clock = MonotonicClock() if options.realtime else SteppedClock(on_advance=backend.tick)
         testbed = Testbed(backend.bus, config, clock=clock)
         tracker = None
@@ -90,4 +100,4 @@ def open_session(options: SessionOptions = SessionOptions()) -> Iterator[Session
                 testbed.boot()
             else:
                 testbed.connect()
-            yield Session(config, backend, testbed, tracker, options.realtime)
+            yield Session(config, backend, testbed, tracker, options.realtime, scheduling)

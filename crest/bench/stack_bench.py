@@ -2,6 +2,10 @@
 with the testbed in a process of its own (across a process boundary, as on a real bus) or in the
 master's process.
 
+Each set-up runs under the normal scheduler or with the threads of both processes under SCHED_FIFO
+(the configuration's [sync] realtime_priority, crest.driver.realtime_scheduling); the result says
+what each process got.
+
 Measured from the SYNC frames on the bus (a further handle on the bus timestamps them):
 the achieved rate, the period jitter (|period - nominal|, p50/p99), missed cycles (a period
 longer than 1.5 nominal periods) and the bus load the traffic would put on a real bus.
@@ -43,29 +47,31 @@ class SyncTimes(can.Listener):
 
 
 def full_stack(sync_rate_hz: float = 500.0, duration_s: float = 60.0, controller_name: str = "dahl",
-               testbed_process: bool = True) -> dict:
+               testbed_process: bool = True, realtime_priority: int = 0) -> dict:
     """The dahl circle at `sync_rate_hz`, with the virtual testbed in a process of its own (the master
     reaches its drives over the served bus, as it reaches drives on a real bus) or in this one.
 
-    The served testbed runs the configuration file of this rate (configs/testbed.toml with the SYNC
-    period changed, written to a temporary folder): a testbed process reads its configuration from
-    a file. A run that a safety stop ends (a heartbeat lost when the processes cannot keep up) is
-    measured up to the stop and reported with its cause.
+    The served testbed runs the configuration file of this rate and priority (configs/testbed.toml
+    with the SYNC period and realtime_priority changed, written to a temporary folder): a testbed
+    process reads its configuration from a file. A run that a safety stop ends (a heartbeat lost
+    when the processes cannot keep up) is measured up to the stop and reported with its cause.
     """
     with tempfile.TemporaryDirectory(prefix="crest-stack-") as folder:
-        config = load_testbed_config(_config_at_rate(Path(folder), sync_rate_hz))
+        config = load_testbed_config(_config_at_rate(Path(folder), sync_rate_hz, realtime_priority))
         with _testbed_mode("process" if testbed_process else "in-process"):
             result = _measure(config, sync_rate_hz, duration_s, controller_name)
     return {**result, "testbed": "its own process" if testbed_process else "this process"}
 
 
-def _config_at_rate(folder: Path, sync_rate_hz: float) -> Path:
-    """configs/testbed.toml (with its drive EDS) in `folder`, its SYNC period set to 1/sync_rate_hz."""
+def _config_at_rate(folder: Path, sync_rate_hz: float, realtime_priority: int) -> Path:
+    """configs/testbed.toml (with its drive EDS) in `folder`, its SYNC period set to 1/sync_rate_hz
+    and its threads' real-time priority to `realtime_priority`."""
     source = default_config_path()
-    text, count = re.subn(r"^period_s = \S+", f"period_s = {1.0 / sync_rate_hz!r}", source.read_text(),
-                          flags=re.MULTILINE)
-    if count != 1:
-        raise ValueError(f"{source}: expected one [sync] period_s line, found {count}")
+    text = source.read_text()
+    for key, value in (("period_s", 1.0 / sync_rate_hz), ("realtime_priority", realtime_priority)):
+        text, count = re.subn(rf"^{key} = \S+", f"{key} = {value!r}", text, flags=re.MULTILINE)
+        if count != 1:
+            raise ValueError(f"{source}: expected one [sync] {key} line, found {count}")
     shutil.copy(source.parent / "crest_drive.eds", folder / "crest_drive.eds")
     path = folder / "testbed.toml"
     path.write_text(text)
@@ -100,6 +106,9 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
     stopped, rms_tip_error_mm = None, None
     with open_session(SessionOptions(config=config)) as session:
         session.testbed.home()
+        # into cyclic synchronous position before the timing starts: the change of operation mode is
+        # an SDO exchange between two SYNCs, not a cycle of the control loop
+        session.testbed.cycle(session.testbed.positions())
         monitor = session.backend.monitor_bus()
         listener = SyncTimes()
         meter = BusLoadMeter(config.bus.bitrate, period_s)      # what the frames on the wire take
@@ -113,6 +122,9 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
             monitor.shutdown()
         load = meter.report()
         plant_rate_hz = session.backend.virtual.plant_rate_hz if session.backend.virtual is not None else None
+        master_scheduling = session.scheduling.describe()
+        testbed_scheduling = (session.backend.served.scheduling if session.backend.served is not None
+                              else master_scheduling)
     stamps = np.array(listener.timestamps)
     periods = np.diff(stamps)
     jitter = np.abs(periods - period_s)
@@ -126,4 +138,6 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
             "bus_load_mean": float(load.mean_load), "bus_load_max": float(load.max_load),
             "bus_bitrate_bit_s": int(load.bitrate_bit_s), "cycles_over_bus_capacity": len(load.overloaded),
             "rms_tip_error_mm": rms_tip_error_mm, "plant_rate_hz": plant_rate_hz, "stopped": stopped,
+            "realtime_priority": config.sync.realtime_priority, "master_scheduling": master_scheduling,
+            "testbed_scheduling": testbed_scheduling,
             "goal": "500 Hz with no missed cycle and p99 jitter <= 1 ms"}

@@ -16,6 +16,7 @@ from model import CatheterParams
 GAP_CASES = {"synthetic": "Gap diagnosis, synthetic 10-min 100 Hz log (easy case)",
              "virtual_testbed": "Gap diagnosis, 10-min 100 Hz virtual-testbed log, drawn plant",
              "real": "Gap diagnosis, longest real log"}
+STACK_REALTIME_PRIORITY = 20    # SCHED_FIFO priority of the full stack's threads (crest.driver.realtime_scheduling)
 SECTIONS = ("model", "dynamic", "scaling", "move", "controllers", "rod_plant", "full_stack", "gap", "view")
 
 
@@ -26,7 +27,12 @@ def add_parser(sub) -> None:
                         help="run only these sections")
     parser.add_argument("--stack-seconds", type=float, default=60.0,
                         help="duration of each full-stack run (default 60): 500 Hz and 1 kHz SYNC with the testbed "
-                             "in a process of its own, and 500 Hz with it in the master's process")
+                             "in a process of its own, and 500 Hz with it in the master's process, each with the "
+                             "threads at --realtime-priority; 500 Hz across processes also under the normal scheduler")
+    parser.add_argument("--realtime-priority", type=int, default=STACK_REALTIME_PRIORITY, choices=range(1, 100),
+                        metavar="1..99",
+                        help=f"full stack: the SCHED_FIFO priority of both processes' threads (default "
+                             f"{STACK_REALTIME_PRIORITY}); where the system does not grant it, the results say so")
     parser.add_argument("--view-seconds", type=float, default=20.0,
                         help="duration of each control-loop run without and with the live view (default 20)")
     parser.add_argument("--gap-seed", type=int, default=0,
@@ -55,9 +61,13 @@ def run(args: argparse.Namespace) -> int:
         "controllers": lambda: controller_cycle_times(params),
         "rod_plant": lambda: plant_bench.rod_plant(),
         "full_stack": lambda: {
-            **{f"{rate:.0f}_hz_testbed_process": stack_bench.full_stack(rate, args.stack_seconds, testbed_process=True)
+            **{f"{rate:.0f}_hz_testbed_process": stack_bench.full_stack(
+                rate, args.stack_seconds, testbed_process=True, realtime_priority=args.realtime_priority)
                for rate in (500.0, 1000.0)},
-            "500_hz_one_process": stack_bench.full_stack(500.0, args.stack_seconds, testbed_process=False)},
+            "500_hz_testbed_process_normal_scheduler": stack_bench.full_stack(500.0, args.stack_seconds,
+                                                                              testbed_process=True),
+            "500_hz_one_process": stack_bench.full_stack(500.0, args.stack_seconds, testbed_process=False,
+                                                         realtime_priority=args.realtime_priority)},
         "gap": lambda: diagnosis_benchmarks(args.gap_seed, args.real_data, cases=args.gap_cases,
                                             progress=lambda message: print(f"crest bench: {message}",
                                                                            file=sys.stderr, flush=True)),
@@ -107,7 +117,7 @@ def format_table(results: dict) -> str:
                      f">= {r['goal_step_rate_hz']:.0f} steps/s", r["step_rate_hz"] >= r["goal_step_rate_hz"]))
     for key, r in results.get("full_stack", {}).items():
         rows.append((f"Full stack at {r['sync_rate_hz_nominal']:.0f} Hz SYNC, {r['duration_s']:.0f} s, testbed in "
-                     f"{r['testbed']}",
+                     f"{r['testbed']}; master: {r['master_scheduling']}, testbed: {r['testbed_scheduling']}",
                      f"{r['achieved_rate_hz']:.0f} Hz, jitter p50 {r['jitter_p50_ms']:.2f} / p99 "
                      f"{r['jitter_p99_ms']:.2f} ms, {r['missed_cycles']} missed, bus load "
                      f"{100 * r['bus_load_mean']:.0f}% of {r['bus_bitrate_bit_s'] / 1e6:g} Mbit/s"

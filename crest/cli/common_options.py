@@ -4,6 +4,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import sys
 from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
@@ -142,9 +143,13 @@ def session_options(args: argparse.Namespace, **overrides) -> SessionOptions:
     effects = dict(parse_effect(text) for text in getattr(args, "effect", []))
     values = dict(config_path=args.config, plant=args.plant, plant_config=args.plant_config,
                   faults=tuple(args.fault), effects=effects,
-                  realtime=not getattr(args, "fast", False))
+                  realtime=not getattr(args, "fast", False), on_notice=print_notice)
     values.update(overrides)
     return SessionOptions(**values)
+
+
+def print_notice(line: str) -> None:
+    print(f"crest: {line}", file=sys.stderr, flush=True)
 
 
 def catheter_params(args: argparse.Namespace) -> CatheterParams:

@@ -79,6 +79,7 @@ def _announce(served, state_file: Path) -> None:
           f"  state file: {state_file}\n"
           + (f"  CPU:        {', '.join(map(str, served.cpus))} (the commands that join it run on the others)\n"
              if served.cpus else "")
+          + f"  threads:    {served.scheduling}\n"
           + ("  clock:      simulated: it moves only with the TIME stamps of a command run with --fast\n"
              if served.simulated_time else "")
           + "Other crest commands on this configuration join it now. Stop it with Ctrl-C "

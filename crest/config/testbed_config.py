@@ -21,6 +21,8 @@ from typing import Any
 
 from configs import CONFIG_DIR
 
+REALTIME_PRIORITY_MAX = 99     # SCHED_FIFO's priorities are 1..99 on Linux
+
 TENDON_AXIS_NAMES = ("tendon1", "tendon2", "tendon3", "tendon4")
 INSERTION_AXIS_NAME = "insertion"
 AXIS_KINDS = ("tendon", "insertion")
@@ -75,9 +77,13 @@ class BusConfig:
 
 @dataclass(frozen=True)
 class SyncConfig:
-    """The SYNC producer (0x1005/0x1006). TPDOs answer and the control loop runs every period_s."""
+    """The SYNC producer (0x1005/0x1006). TPDOs answer and the control loop runs every period_s.
+    realtime_priority: the SCHED_FIFO priority of the master's and the virtual testbed's threads
+    while they run in real time (crest.driver.realtime_scheduling); 0, the default, keeps the
+    normal scheduler."""
 
     period_s: float
+    realtime_priority: int = 0
 
 
 @dataclass(frozen=True)
@@ -353,10 +359,12 @@ def _parse_bus(table: _Table) -> BusConfig:
 
 
 def _parse_sync(table: _Table) -> SyncConfig:
-    table.only_keys(("period_s",))
+    table.only_keys(("period_s", "realtime_priority"))
     period_s = table.number("period_s", positive=True)
     _check_whole_units(table, "period_s", period_s, 1e-6, "us", 0xFFFFFFFF)
-    return SyncConfig(period_s=period_s)
+    realtime_priority = (table.integer("realtime_priority", minimum=0, maximum=REALTIME_PRIORITY_MAX)
+                         if "realtime_priority" in table.data else 0)
+    return SyncConfig(period_s=period_s, realtime_priority=realtime_priority)
 
 
 def _parse_master(table: _Table) -> MasterConfig:

@@ -61,7 +61,7 @@ class SyncCycle:
             self.next_sync_s = self._clock.now_s()
         self._clock.wait_until(self.next_sync_s)
         now_s = self._clock.now_s()
-        self.next_sync_s = max(self.next_sync_s + self.period_s, now_s)
+        self.next_sync_s = self._following_sync_s(now_s)
         self._heartbeat.poll(now_s)
         with self._feedback_changed:
             marks = [axis.tpdo_count for axis in self.axes]
@@ -79,6 +79,16 @@ class SyncCycle:
                 timeout=self.reply_timeout_s)
             fresh = tuple(axis.tpdo_count > mark for axis, mark in zip(self.axes, marks))
         return now_s, fresh
+
+    def _following_sync_s(self, now_s: float) -> float:
+        """When the SYNC after the one sent at `now_s` is due. On its grid (due + period) when this
+        one left less than a period late; a full period after it otherwise (after a pause such as a
+        mode change's SDO exchange, or a stall), rather than at once: drives interpolating in cyclic
+        synchronous position assume SYNCs at least a period apart, and a burst of catch-up SYNCs
+        would step their set-points."""
+        if now_s - self.next_sync_s > self.period_s:
+            return now_s + self.period_s
+        return self.next_sync_s + self.period_s
 
     def quick_stop_all(self) -> None:
         """Quick stop to every drive now, and in every later cycle (any thread).

@@ -17,6 +17,8 @@ import os
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 
+from crest.driver.realtime_scheduling import thread_ids
+
 
 def allowed_cpus() -> tuple[int, ...]:
     """The CPUs this thread may run on (empty where the platform cannot say)."""
@@ -34,11 +36,7 @@ def testbed_cpus() -> tuple[int, ...]:
 def pin_process(cpus: Sequence[int]) -> None:
     """Every thread of this process on `cpus`; threads it starts later inherit it (on Linux each
     thread has its own CPU mask, so one call for the process is not enough)."""
-    try:
-        threads = [int(name) for name in os.listdir("/proc/self/task")]
-    except OSError:
-        threads = [0]
-    for thread in threads:
+    for thread in thread_ids():
         try:
             os.sched_setaffinity(thread, cpus)
         except ProcessLookupError:

@@ -14,7 +14,9 @@ with the testbed inside the command. A testbed served on its own has no such
 command, and its fault times count from its start.
 
 Where the machine lets it use two CPUs or more, the testbed runs on the last one, and the commands
-that join it on the others (cpu_split.py).
+that join it on the others (cpu_split.py). In real time its threads run under SCHED_FIFO at the
+configuration's [sync] realtime_priority where the system grants it
+(crest.driver.realtime_scheduling); the state file says what they got.
 """
 from __future__ import annotations
 
@@ -26,6 +28,7 @@ from pathlib import Path
 
 from crest.backend import serve_virtual_testbed
 from crest.config import TestbedConfig
+from crest.driver.realtime_scheduling import realtime_threads
 from crest.testbed_service.cpu_split import pin_process, testbed_cpus
 from crest.testbed_service.state_file import ServedTestbed, claim_serving, config_digest, state_path
 
@@ -47,7 +50,8 @@ def serve_until_stopped(config: TestbedConfig, *, plant: str | None = None, plan
     if parent_fd is not None:
         threading.Thread(target=_watch_parent, args=(parent_fd, clock_requests), name="parent-pipe",
                          daemon=True).start()
-    with claim_serving() as publish:
+    priority = 0 if simulated_time else config.sync.realtime_priority
+    with claim_serving() as publish, realtime_threads(priority) as scheduling:
         server = serve_virtual_testbed(config, plant=plant, plant_config=plant_config, effects=effects,
                                        faults=faults, faults_wait_for_run=parent_fd is not None, port=port,
                                        simulated_time=simulated_time)
@@ -58,7 +62,8 @@ def serve_until_stopped(config: TestbedConfig, *, plant: str | None = None, plan
             served = ServedTestbed(pid=os.getpid(), bus_interface=server.bus_interface,
                                    bus_channel=server.bus_channel, tracker_port=server.tracker_port,
                                    config=str(Path(config.path).resolve()), config_digest=config_digest(config),
-                                   simulated_time=simulated_time, cpus=cpus)
+                                   simulated_time=simulated_time, cpus=cpus,
+                                   scheduling=scheduling.describe())
             publish(served)
             on_ready(served, state_path())
             while True:

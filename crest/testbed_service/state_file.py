@@ -5,14 +5,15 @@ writes ``testbed.json`` beside it::
 
     {"pid": 4242, "bus_interface": "remote", "bus_channel": "ws://127.0.0.1:40123/",
      "tracker_port": "/dev/pts/7", "config": "/path/to/testbed.toml", "config_digest": "9f2c...",
-     "simulated_time": false, "cpus": [1]}
+     "simulated_time": false, "cpus": [1], "scheduling": "normal scheduler"}
 
 ``config_digest`` is `config_digest(config)` of the configuration the testbed was built from: a
 command joins only a testbed built from the configuration it runs with, to the last value.
 ``simulated_time`` is true for a testbed whose clock moves only with its master's TIME stamps
 (`crest testbed serve --simulated-time`, sim_backend.time_stamps): only a command in simulated time
 (`--fast`) can drive it. ``cpus`` are the CPUs the testbed runs on (crest.testbed_service.cpu_split;
-empty when it is not pinned): a command that joins it runs on the others.
+empty when it is not pinned): a command that joins it runs on the others. ``scheduling`` is what
+its threads run under (crest.driver.realtime_scheduling: real-time, or the normal scheduler and why).
 
 The kernel releases the lock when the server ends, however it ends (kill -9 included). A state
 file whose lock nobody holds is therefore stale, left by a killed server: the other commands
@@ -51,6 +52,7 @@ class ServedTestbed:
     config_digest: str
     simulated_time: bool = False
     cpus: tuple[int, ...] = ()
+    scheduling: str = "normal scheduler"
 
     def describe(self) -> str:
         return (f"pid {self.pid}, CAN bus interface '{self.bus_interface}' channel '{self.bus_channel}', "

@@ -3,6 +3,7 @@
 import os
 from dataclasses import replace
 
+import numpy as np
 import pytest
 
 from crest.driver import BootError, IdentityMismatch, ReadBackMismatch
@@ -52,6 +53,15 @@ def test_boot_writes_the_axis_parameters_in_counts(booted):
         assert value(0x1017) == 50
         assert value(0x1016, 1) == 127 << 16 | 250                       # watch node 127, 250 ms
         assert value(0x6061) == 1                                        # profile position
+
+
+def test_after_a_pause_the_sync_resumes_a_full_period_apart_not_in_a_burst(booted):
+    period_s = booted.config.sync.period_s
+    on_grid = [booted.testbed.cycle().t_s for _ in range(3)]
+    booted.advance(5 * period_s)                         # a pause: the host sends nothing
+    resumed = [booted.testbed.cycle().t_s for _ in range(3)]
+    assert np.diff(on_grid) == pytest.approx([period_s] * 2)
+    assert np.diff(resumed) == pytest.approx([period_s] * 2)   # before: the second SYNC at once
 
 
 def test_identity_is_reported_from_0x1018(make_rig):

@@ -35,10 +35,11 @@ RELAXED_TIMING = {         # [master] key: value
 }
 
 
-def relaxed_config(folder: Path) -> Path:
-    """configs/testbed.toml with RELAXED_TIMING, written into `folder` with its EDS."""
+def relaxed_config(folder: Path, **changes) -> Path:
+    """configs/testbed.toml with RELAXED_TIMING and `changes` (further key = value lines),
+    written into `folder` with its EDS."""
     text = default_config_path().read_text()
-    for key, value in RELAXED_TIMING.items():
+    for key, value in {**RELAXED_TIMING, **changes}.items():
         text, count = re.subn(rf"^{key} = \S+", f"{key} = {value}", text, flags=re.MULTILINE)
         assert count == 1, key
     folder.mkdir(parents=True, exist_ok=True)
@@ -66,13 +67,14 @@ class ServedTestbed:
         return start_crest(*args, env=self.env, **kwargs)
 
 
-def start_served_testbed(tmp_path: Path, config: Path | None = None, *options: str) -> ServedTestbed:
-    """`crest testbed serve [options]`, returned once its state file is written (the caller stops it)."""
+def start_served_testbed(tmp_path: Path, config: Path | None = None, *options: str, **popen) -> ServedTestbed:
+    """`crest testbed serve [options]`, returned once its state file is written (the caller stops it);
+    `popen`: further arguments of subprocess.Popen."""
     env = {"XDG_RUNTIME_DIR": str(tmp_path / "runtime")}
     config = config or relaxed_config(tmp_path / "config")
     state_file = tmp_path / "runtime" / "crest" / "testbed.json"
     process = start_crest("testbed", "serve", "--config", str(config), *options, env=env,
-                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **popen)
     served = ServedTestbed(process, config, env, state_file)
     deadline = time.monotonic() + START_TIMEOUT_S
     while not (state_file.exists() and _state_pid(state_file) == process.pid):
