@@ -76,6 +76,8 @@ class VirtualTestbed:
             raise ValueError("a virtual testbed keeps one clock: real time or the bus's TIME stamps, not both")
         self.drives.start()
         self.drives.add_sync_listener(self._on_sync)
+        # in simulated time a tracker frame is a function of the plant's step it samples (SimTracker.draw_key)
+        self.tracker.draw_key = None if realtime else (lambda: self.syncs_seen)
         if time_stamps:
             follow_time_stamps(self.drives, self.tick, self.start_fault_clock)
         self.tracker.start()

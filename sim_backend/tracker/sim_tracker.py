@@ -57,10 +57,17 @@ class SimTracker:
         dropout: probability in [0, 1] that a frame reports the tool MISSING.
         seed: seed of the numpy Generator that draws noise and dropout.
         tool_handle: the port handle the sensor sits on (the testbed's ``[tracker].tool_port``).
+        draw_key: None, each frame draws its noise and dropout after the previous frame's; or
+            called (after tip_source) for the instant the frame describes, and the frame's draws come
+            from the Generator of (seed, that key). Simulated time keys them on the plant's step:
+            a frame asked for again at the same instant (the driver's retry after a reply it
+            thought lost, on a loaded machine) repeats it instead of shifting every later frame's
+            noise, so a recording in simulated time does not depend on how busy the machine was.
     """
 
     def __init__(self, tip_source: Callable[[], np.ndarray | None], *, noise_mm: float = 0.0,
-                 dropout: float = 0.0, seed: int = 0, tool_handle: int = 0x0A):
+                 dropout: float = 0.0, seed: int = 0, tool_handle: int = 0x0A,
+                 draw_key: Callable[[], int] | None = None):
         if noise_mm < 0.0:
             raise ValueError(f"tracker noise_mm must be >= 0, got {noise_mm}")
         if not 0.0 <= dropout <= 1.0:
@@ -71,7 +78,9 @@ class SimTracker:
         self.noise_mm = noise_mm
         self.dropout = dropout
         self.tool_handle = tool_handle
+        self._seed = seed
         self._rng = np.random.default_rng(seed)
+        self.draw_key = draw_key
         self._faults: set[TrackerFault] = set()
         self._faults_lock = threading.Lock()
         self._initialized = False
@@ -278,9 +287,10 @@ class SimTracker:
     def _measure(self) -> tuple[str | None, int]:
         """This frame's transform text (None = MISSING) and port status."""
         status = self._port_status
-        dropped = self._rng.random() < self.dropout
-        noise_mm = self._rng.normal(0.0, self.noise_mm, 3)
         tip_mm = self.tip_source()
+        rng = self._rng if self.draw_key is None else np.random.default_rng((self._seed, self.draw_key()))
+        dropped = rng.random() < self.dropout
+        noise_mm = rng.normal(0.0, self.noise_mm, 3)
         if dropped or tip_mm is None or TrackerFault.MISSING_TOOL in self.faults:
             return None, status
         position_mm = np.asarray(tip_mm, dtype=float).reshape(3) + noise_mm

@@ -203,6 +203,26 @@ def test_same_seed_gives_the_same_reply_stream():
     assert streams[0] == streams[1]
 
 
+def test_keyed_frames_repeat_at_the_same_instant_and_a_repeat_shifts_no_later_frame():
+    """As in simulated time: each frame's noise and dropout are those of the instant it samples,
+    so the driver asking twice at one instant (a retry on a loaded machine) changes nothing after."""
+    streams = []
+    for repeats in ([1, 1, 1, 1, 1, 1], [1, 3, 1, 2, 1, 1]):
+        instant = [0]
+        tracker = SimTracker(lambda: TIP_MM, noise_mm=1.0, dropout=0.2, seed=7, draw_key=lambda: instant[0])
+        setup_tracking(tracker)
+        stream = []
+        for count in repeats:
+            instant[0] += 1
+            frames = tx_positions_mm(tracker, count)
+            assert all(frame == frames[0] for frame in frames)
+            stream.append(frames[0])
+        tracker.stop()
+        streams.append(stream)
+    assert streams[0] == streams[1]
+    assert len({str(frame) for frame in streams[0]}) > 1      # the instants differ from one another
+
+
 @pytest.mark.parametrize("kwargs", [{"noise_mm": -1.0}, {"dropout": 1.5}, {"tool_handle": 0x100}])
 def test_invalid_settings_are_refused(kwargs):
     with pytest.raises(ValueError, match=next(iter(kwargs))):
