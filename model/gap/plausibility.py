@@ -7,7 +7,12 @@ Two checks, each giving a reason when it fails (a fit that passes both has no re
    than the effect can be, i.e. it absorbs something else. Lumen compression acts near the base:
    its extent may reach NEAR_BASE_FRACTION of the catheter's flexible length, no further (a
    compression along the whole catheter is a different moment arm or stiffness, i.e. model form:
-   on the rod plant without effects a fit with extent 181 mm took 48 % of the residual).
+   on the rod plant without effects a fit with extent 181 mm took 48 % of the residual). A
+   rate lag must be resolvable at the fits' sampling: its time constant at least
+   MIN_LAG_SAMPLES of a (decimated) sample period. A lag shorter than that moves each sample by
+   less than it moves between samples; with tau -> 0 the creep s + tau ds/dt = c T is the
+   elastic stretch c T, so such a fit is tendon elasticity with one freedom more (on the rod
+   plant, a drive line made only more elastic was named rate_lag with tau = 0.029 s at 10 Hz).
 2. Signature: with the per-sample gain g_t = |e_before,t|^2 - |e_after,t|^2 (mm^2) on the
    selection half, the gain's concentration in the effect's signature region R,
 
@@ -45,6 +50,7 @@ ZERO_LOAD_DEG = 15.0
 HIGH_ARTICULATION_DEG = 45.0
 FAST_MM_S = 2.0
 NEAR_BASE_FRACTION = 0.5
+MIN_LAG_SAMPLES = 0.5
 EVERY_REGION = "every region"
 
 
@@ -68,11 +74,17 @@ def _region_masks(f: SampleFeatures) -> dict:
     }
 
 
-def range_reasons(effect_id: str, values: tuple[float, ...], flexible_length_mm: float | None = None) -> list[str]:
+def range_reasons(effect_id: str, values: tuple[float, ...], flexible_length_mm: float | None = None,
+                  sample_period_s: float | None = None) -> list[str]:
     """Why the effect's fitted values are implausible (empty: plausible); flexible_length_mm: the
-    catheter's, for the effects whose range depends on it (None: not checked)."""
+    catheter's, and sample_period_s: the fits' sample period, for the effects whose range depends on
+    them (None: not checked)."""
     candidate = effect(effect_id)
     reasons = []
+    if effect_id == "rate_lag" and sample_period_s is not None and values[1] < MIN_LAG_SAMPLES * sample_period_s:
+        reasons.append(f"rate_lag.time_s = {values[1]:.3g} s is shorter than {MIN_LAG_SAMPLES:g} of the fits' sample "
+                       f"period ({sample_period_s:g} s): a lag that short is not resolved, it is an elastic drive "
+                       "line (tendon_elasticity) with one freedom more")
     if effect_id == "lumen_compression" and flexible_length_mm is not None \
             and values[1] > NEAR_BASE_FRACTION * flexible_length_mm:
         reasons.append(f"lumen_compression.extent_mm = {values[1]:.4g} reaches beyond {NEAR_BASE_FRACTION:g} of the "

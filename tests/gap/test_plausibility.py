@@ -28,6 +28,12 @@ def test_a_short_lag_in_a_range_over_decades_is_not_at_its_limit():
     assert len(reasons) == 1 and "time_s" in reasons[0] and "limit" in reasons[0]
 
 
+def test_a_lag_shorter_than_half_a_sample_is_an_elastic_drive_line_not_a_rate_lag():
+    assert range_reasons("rate_lag", (0.05, 0.057), sample_period_s=0.1) == []
+    reasons = range_reasons("rate_lag", (0.026, 0.029), sample_period_s=0.1)
+    assert len(reasons) == 1 and "not resolved" in reasons[0] and "tendon_elasticity" in reasons[0]
+
+
 def test_gravity_that_only_improves_bent_samples_does_not_match_its_signature():
     """Sag is present at zero load: a 'gravity' fit whose gain lies only where the catheter is bent
     absorbs something else."""
