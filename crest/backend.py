@@ -357,6 +357,16 @@ def plant_from_description(plant_toml: Path | None, effects: dict | None = None)
     return load_plant_description(plant_toml, effects)[0]
 
 
+def plant_description_refusal(plant_toml: Path) -> str | None:
+    """Why the virtual testbed cannot build the plant this TOML describes (its description's own
+    check, e.g. a lumen drift that puts the lumens outside the shaft); None where it can."""
+    try:
+        plant_from_description(plant_toml)
+    except ValueError as error:     # the plant descriptions' errors (sim_backend.plant) are ValueErrors
+        return str(error)
+    return None
+
+
 def plant_description_family(plant_toml: Path | None) -> str:
     """The plant family ("dahl" or "rod") a plant TOML describes (None: configs/virtual_plant.toml, "dahl")."""
     from sim_backend.plant.plant_description import plant_family

@@ -50,7 +50,7 @@ from pathlib import Path
 
 import numpy as np
 
-from crest.backend import plant_effect_ranges
+from crest.backend import plant_description_refusal, plant_effect_ranges
 from crest.config import TestbedConfig, load_testbed_config
 from crest.driver import SafetyStop
 from crest.experiment.excitation_run import ExcitationPlan, plan_excitation, record_excitation
@@ -235,12 +235,18 @@ def record_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Exci
     """Training and held-out logs of the case's plant on the virtual testbed, as `crest excite` records
     them (in a process of its own, see `call_isolated`; ended once `cancel` is set), and on the rod family
     with an effect a second held-out log of the plant without it (None otherwise); a plant whose solver
-    fails is redrawn."""
+    fails, or that its own description refuses (a drawn lumen drift that puts the lumens outside the
+    shaft), is redrawn."""
+    refusals = []
     for redraw in range(MAX_REDRAWS + 1):
         if redraw:
             case = _redrawn(case, redraw, prior)
-        options = SessionOptions(config=config, plant_config=write_plant_config(case, folder / f"plant_{redraw}"),
-                                 realtime=False, in_process=True)
+        plant_toml = write_plant_config(case, folder / f"plant_{redraw}")
+        refused = plant_description_refusal(plant_toml)
+        if refused is not None:
+            refusals.append(refused)
+            continue
+        options = SessionOptions(config=config, plant_config=plant_toml, realtime=False, in_process=True)
         try:
             results = call_isolated(_record, options, plan, folder / f"logs_{redraw}", prior,
                                     timeout_s=RECORD_TIMEOUT_S, cancel=cancel)
@@ -260,7 +266,8 @@ def record_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Exci
             except (PlantFailure, CallTimedOut):
                 continue
         return case, results["train"].log_path, results["holdout"].log_path, reference
-    raise PlantFailure(f"blind case {case.index}: the plant failed in {MAX_REDRAWS + 1} draws")
+    raise PlantFailure(f"blind case {case.index}: the plant failed in {MAX_REDRAWS + 1} draws"
+                       + (f" ({len(refusals)} refused by its description, last: {refusals[-1]})" if refusals else ""))
 
 
 def _record(options: SessionOptions, plan: ExcitationPlan, folder: Path, prior: CatheterParams) -> dict:
