@@ -69,7 +69,7 @@ def markdown(result: dict) -> str:
             lines.append(f"| {family} | {row['case']} | {truth} | {row.get('skipped') or row.get('no_result')} "
                          "| | | | | |")
             continue
-        oracle = f"{row['oracle_shrink']:.2f}" if row.get("oracle_shrink") is not None else "-"
+        oracle = f"{row['oracle_shrink']:.2f}" if _has_oracle(row) else ("failed" if "oracle_shrink" in row else "-")
         lines.append(f"| {family} | {row['case']} | {truth} | {'+'.join(row['predicted_effects']) or row['predicted']} | "
                      f"{row['effect_rms_mm']:.2f} | {row.get('relative_size', 0.0):.2f} | {row['noise_mm']:.2f} | "
                      f"{row['predicted_shrink']:.2f} | {oracle} |")
@@ -146,10 +146,16 @@ def _confusion_figure(confusion: dict) -> Figure:
     return figure
 
 
+def _has_oracle(row: dict) -> bool:
+    """The case has an oracle shrink to compare with: not where the oracle's held-out prediction
+    failed (-inf in the run, null in its JSON)."""
+    return row.get("oracle_shrink") is not None and bool(np.isfinite(row["oracle_shrink"]))
+
+
 def _shrink_figure(cases: list[dict]) -> Figure:
     figure = new_figure(5.0, 4.6)
     ax = figure.subplots()
-    scored = [r for r in cases if r.get("oracle_shrink") is not None]
+    scored = [r for r in cases if _has_oracle(r)]
     hit = [r for r in scored if sorted(r["predicted_effects"]) == sorted(r["truth"])]
     miss = [r for r in scored if r not in hit]
     for rows, label, color in ((hit, "verdict right", "tab:green"), (miss, "verdict wrong", "tab:red")):

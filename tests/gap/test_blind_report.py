@@ -35,3 +35,13 @@ def test_report_writes_markdown_and_figures(tmp_path):
     assert (tmp_path / "blind" / "confusion_dahl.png").stat().st_size > 1000
     assert (tmp_path / "blind" / "detection_dahl.png").stat().st_size > 1000
     assert (tmp_path / "blind" / "shrink.png").stat().st_size > 1000
+
+
+def test_a_case_whose_oracle_failed_is_reported_as_failed_and_left_out_of_the_shrink_figure(tmp_path):
+    """As on rod seed 50: the oracle's held-out prediction failed (-inf); the report stopped on it."""
+    failed = dict(case(4, "single", ["tendon_elasticity"], "tendon_elasticity", 0.49, 0.0), oracle_shrink=float("-inf"))
+    del failed["shrink_error_pp"]        # run_case scores no shrink error without a finite oracle
+    rows = result()["cases"] + [failed]
+    path = write_blind_report({**result(), "cases": rows, "score": {"dahl": score(rows)}}, tmp_path / "blind")
+    assert "| dahl | 4 | tendon_elasticity | tendon_elasticity | 0.80 | 0.80 | 0.10 | 0.49 | failed |" in path.read_text()
+    assert (tmp_path / "blind" / "shrink.png").stat().st_size > 1000
