@@ -26,6 +26,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 
+
 @dataclass(frozen=True)
 class Scheduling:
     """What the threads run under: SCHED_FIFO at `priority`, or (priority 0) the normal scheduler;
