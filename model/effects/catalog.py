@@ -40,12 +40,13 @@ EFFECTS: dict[str, CandidateEffect] = {e.id: e for e in (
         apply=lambda t, v: t.replace(tube_play_mm=v[0])),
     CandidateEffect(
         id="gravity",
-        physics="sag under the catheter's own weight: element masses loaded by g in the base frame",
-        param_names=("g_x_m_s2", "g_y_m_s2", "g_z_m_s2"), typical=(0.0, -9.81, 0.0),
-        lower=(-20.0, -20.0, -20.0), upper=(20.0, 20.0, 20.0),   # up to 2 g: a fluid-filled catheter weighs more
+        physics="sag under the catheter's own weight: element masses loaded by g across the insertion "
+                "axis, which the testbed holds horizontal (g in the base x-y plane, g_z = 0)",
+        param_names=("g_x_m_s2", "g_y_m_s2"), typical=(0.0, -9.81),
+        lower=(-20.0, -20.0), upper=(20.0, 20.0),   # up to 2 g: a fluid-filled catheter weighs more
         signature="a fixed-direction offset that grows with free length, present even at zero load",
         signature_region="zero load",
-        apply=lambda t, v: t.replace(gravity_m_s2=(v[0], v[1], v[2]))),
+        apply=lambda t, v: t.replace(gravity_m_s2=(v[0], v[1], 0.0))),
     CandidateEffect(
         id="torsion",
         physics="twist of the lumens along the catheter: each bending plane couples into the other",

@@ -21,7 +21,7 @@ def test_a_failed_prediction_scores_last_and_is_marked_failed():
     rng = np.random.default_rng(0)
     baseline = [rng.normal(0.0, 1.0, (200, 3))]
     split = split_holdout([200])
-    better = evaluate(("gravity",), fit({"gravity": (0.0, -9.81, 0.0)}), [0.5 * baseline[0]], baseline, split)
+    better = evaluate(("gravity",), fit({"gravity": (0.0, -9.81)}), [0.5 * baseline[0]], baseline, split)
     diverged_errors = baseline[0].copy()
     diverged_errors[150:] = np.inf        # the model diverged on the report half only
     diverged = evaluate(("backlash",), fit({"backlash": (0.4,)}), [diverged_errors], baseline, split)
