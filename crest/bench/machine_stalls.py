@@ -1,0 +1,117 @@
+"""The machine's own stalls, measured beside a benchmark by an idle real-time probe process.
+
+A virtual machine is paused now and then by its host (steal time, a host's housekeeping), and
+every program on it then misses its deadlines at once, whatever its own code does. `cyclictest`
+(rt-tests) measures this latency; this probe does the same from Python, so `crest bench` can say,
+for each missed cycle of the full stack, whether the machine itself stalled at that moment.
+
+The probe is a process of its own that does nothing but sleep to absolute deadlines every
+`period_s`, under SCHED_FIFO at a priority above every thread of the benchmark (so none of them
+can run in its way). Each wake-up later than STALL_THRESHOLD_S is a stall of the machine: the
+interval [wake - lateness, wake]. It reads stdin and stops when stdin closes (also when its
+parent dies), then prints its report as one JSON line.
+
+    python -m crest.bench.machine_stalls PERIOD_S PRIORITY
+"""
+from __future__ import annotations
+
+import json
+import select
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+
+from crest.driver.realtime_scheduling import realtime_threads
+
+PROBE_PERIOD_S = 0.001
+PROBE_PRIORITY = 90                # cyclictest's customary priority, above the bench's 20
+STALL_THRESHOLD_S = 0.0005         # a wake-up this late is a stall (the probe itself wakes in ~0.05 ms)
+READY = "ready"
+
+
+@dataclass(frozen=True)
+class StallReport:
+    """What the probe saw: its scheduling, its wake-ups, and each stall as (start_s, end_s) on
+    time.time()'s clock (the clock of python-can's frame timestamps)."""
+
+    scheduling: str
+    wakeups: int
+    stalls: tuple[tuple[float, float], ...]
+
+    @property
+    def longest_ms(self) -> float:
+        return max((1e3 * (end - start) for start, end in self.stalls), default=0.0)
+
+    def overlapping(self, start_s: float, end_s: float) -> bool:
+        """Did the machine stall at some time within [start_s, end_s]?"""
+        return any(stall_start < end_s and stall_end > start_s for stall_start, stall_end in self.stalls)
+
+
+class MachineStallProbe:
+    """The probe process, for a `with` block: `report` holds what it saw once the block ends."""
+
+    def __init__(self, priority: int = PROBE_PRIORITY, period_s: float = PROBE_PERIOD_S):
+        self.priority = priority
+        self.period_s = period_s
+        self.report: StallReport | None = None
+        self._process: subprocess.Popen | None = None
+
+    def __enter__(self) -> "MachineStallProbe":
+        self._process = subprocess.Popen(
+            [sys.executable, "-m", "crest.bench.machine_stalls", repr(self.period_s), str(self.priority)],
+            stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        first = self._process.stdout.readline().strip()
+        if first != READY:
+            self._process.kill()
+            raise RuntimeError(f"the machine stall probe did not start (it said {first!r})")
+        return self
+
+    @property
+    def pid(self) -> int:
+        return self._process.pid
+
+    def __exit__(self, *exc_info) -> None:
+        try:
+            output, _ = self._process.communicate(input="", timeout=30.0)   # closing stdin stops it
+            self.report = parse_report(output)
+        finally:
+            if self._process.poll() is None:
+                self._process.kill()
+                self._process.wait()
+
+
+def parse_report(line: str) -> StallReport:
+    raw = json.loads(line)
+    return StallReport(scheduling=raw["scheduling"], wakeups=int(raw["wakeups"]),
+                       stalls=tuple((float(start), float(end)) for start, end in raw["stalls"]))
+
+
+def probe(period_s: float, priority: int) -> dict:
+    """Wake every `period_s` until stdin closes; the report as a dict (see the module doc).
+
+    The k-th deadline is start + k period (absolute, so a late wake-up does not shift the later
+    ones); a wake-up `late` seconds after its deadline records the stall [now - late, now].
+    """
+    stalls, wakeups = [], 0
+    with realtime_threads(priority) as scheduling:
+        print(READY, flush=True)
+        start = time.monotonic()
+        deadline = start + period_s
+        while True:
+            readable, _, _ = select.select([sys.stdin], [], [], max(0.0, deadline - time.monotonic()))
+            if readable and not sys.stdin.readline():
+                break                                           # stdin closed: stop
+            late_s = time.monotonic() - deadline
+            if late_s < 0.0:
+                continue                                        # woken early by input; sleep on
+            wakeups += 1
+            if late_s > STALL_THRESHOLD_S:
+                now_s = time.time()
+                stalls.append((now_s - late_s, now_s))
+            deadline += period_s * (1 + int(late_s // period_s))   # the next deadline still ahead
+    return {"scheduling": scheduling.describe(), "wakeups": wakeups, "stalls": stalls}
+
+
+if __name__ == "__main__":
+    print(json.dumps(probe(float(sys.argv[1]), int(sys.argv[2]))), flush=True)

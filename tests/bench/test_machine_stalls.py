@@ -1,0 +1,39 @@
+"""The machine stall probe (crest.bench.machine_stalls): an idle process that records when it woke
+up late, so `crest bench` can tell the machine's own stalls from the stack's."""
+import os
+import signal
+import time
+
+import pytest
+
+from crest.bench.machine_stalls import MachineStallProbe, StallReport
+
+
+def test_the_probe_in_another_process_records_a_pause_of_that_process_as_a_stall():
+    """SIGSTOP freezes the probe's process as a host freezes a virtual machine: on SIGCONT it wakes
+    late, and the stall it records spans the pause."""
+    with MachineStallProbe(priority=0) as probe:
+        time.sleep(0.3)
+        paused_s = time.time()
+        os.kill(probe.pid, signal.SIGSTOP)
+        time.sleep(0.25)
+        os.kill(probe.pid, signal.SIGCONT)
+        resumed_s = time.time()
+        time.sleep(0.3)
+    report = probe.report
+    assert report.scheduling == "normal scheduler" and report.wakeups > 100
+    pause = [(start, end) for start, end in report.stalls if end - start > 0.2]
+    assert len(pause) == 1
+    start, end = pause[0]
+    assert paused_s - 0.01 < start < paused_s + 0.05 and resumed_s - 0.05 < end < resumed_s + 0.5
+    assert report.overlapping(paused_s + 0.1, paused_s + 0.11)
+    assert report.longest_ms > 200.0
+
+
+def test_a_missed_cycle_counts_as_on_a_stall_only_where_the_two_overlap():
+    report = StallReport("real-time (SCHED_FIFO, priority 90)", 1000, ((10.000, 10.008), (20.0, 20.001)))
+    assert report.overlapping(9.999, 10.003)            # the cycle began before the stall
+    assert report.overlapping(10.007, 10.010)           # ... or ended after it
+    assert not report.overlapping(10.009, 10.012)
+    assert not report.overlapping(15.0, 15.003)
+    assert report.longest_ms == pytest.approx(8.0)
