@@ -1,15 +1,17 @@
-"""The machine's own stalls, measured beside a benchmark by an idle real-time probe process.
+"""The machine's own stalls: how late an idle real-time process wakes up, the floor under any cycle.
 
 A virtual machine is paused now and then by its host (steal time, a host's housekeeping), and
 every program on it then misses its deadlines at once, whatever its own code does. `cyclictest`
-(rt-tests) measures this latency; this probe does the same from Python, so `crest bench` can say,
-for each missed cycle of the full stack, whether the machine itself stalled at that moment.
+(rt-tests) measures this latency; this probe does the same from Python, so `crest bench` can put
+the full stack's missed cycles next to the machine's own stalls, measured on the same machine
+just before (`machine_floor`). It runs alone, not beside the stack: a process waking every
+millisecond at a priority above the stack's threads would take its own share of their CPUs.
 
 The probe is a process of its own that does nothing but sleep to absolute deadlines every
-`period_s`, under SCHED_FIFO at a priority above every thread of the benchmark (so none of them
-can run in its way). Each wake-up later than STALL_THRESHOLD_S is a stall of the machine: the
-interval [wake - lateness, wake]. It reads stdin and stops when stdin closes (also when its
-parent dies), then prints its report as one JSON line.
+`period_s`, under SCHED_FIFO at `priority` (nothing of lower priority can run in its way). Each
+wake-up later than STALL_THRESHOLD_S is a stall of the machine: the interval [wake - lateness,
+wake]. It reads stdin and stops when stdin closes (also when its parent dies), then prints its
+report as one JSON line.
 
     python -m crest.bench.machine_stalls PERIOD_S PRIORITY
 """
@@ -43,9 +45,10 @@ class StallReport:
     def longest_ms(self) -> float:
         return max((1e3 * (end - start) for start, end in self.stalls), default=0.0)
 
-    def overlapping(self, start_s: float, end_s: float) -> bool:
-        """Did the machine stall at some time within [start_s, end_s]?"""
-        return any(stall_start < end_s and stall_end > start_s for stall_start, stall_end in self.stalls)
+    def longer_than(self, duration_s: float) -> int:
+        """How many stalls lasted longer than `duration_s` (at 500 Hz, a stall over 1 ms delays a
+        SYNC past 1.5 periods: a missed cycle, whatever the program)."""
+        return sum(end - start > duration_s for start, end in self.stalls)
 
 
 class MachineStallProbe:
@@ -79,6 +82,13 @@ class MachineStallProbe:
             if self._process.poll() is None:
                 self._process.kill()
                 self._process.wait()
+
+
+def machine_floor(duration_s: float, priority: int = PROBE_PRIORITY) -> StallReport:
+    """The probe alone for `duration_s`: the stalls of the machine as it is now."""
+    with MachineStallProbe(priority) as probe:
+        time.sleep(duration_s)
+    return probe.report
 
 
 def parse_report(line: str) -> StallReport:

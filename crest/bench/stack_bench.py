@@ -8,9 +8,7 @@ what each process got.
 
 Measured from the SYNC frames on the bus (a further handle on the bus timestamps them):
 the achieved rate, the period jitter (|period - nominal|, p50/p99), missed cycles (a period
-longer than 1.5 nominal periods) and the bus load the traffic would put on a real bus. Beside the
-run, an idle real-time probe process (crest.bench.machine_stalls) records when the machine itself
-stalled; the result counts the missed cycles that fall on such a stall.
+longer than 1.5 nominal periods) and the bus load the traffic would put on a real bus.
 """
 from __future__ import annotations
 
@@ -26,7 +24,6 @@ import can
 import numpy as np
 
 from control import Articulation, make_controller
-from crest.bench.machine_stalls import PROBE_PRIORITY, MachineStallProbe
 from crest.config import default_config_path, load_testbed_config
 from crest.driver import SafetyStop
 from crest.experiment.builtin_trajectories import BuiltinOptions, builtin_trajectory
@@ -107,8 +104,7 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
                                                    circle_period_s=circle_period_s), period_s, start)
     controller = make_controller(controller_name, workspace, limits, period_s)
     stopped, rms_tip_error_mm = None, None
-    machine = MachineStallProbe(min(99, max(PROBE_PRIORITY, config.sync.realtime_priority + 1)))
-    with machine, open_session(SessionOptions(config=config)) as session:
+    with open_session(SessionOptions(config=config)) as session:
         session.testbed.home()
         # into cyclic synchronous position before the timing starts: the change of operation mode is
         # an SDO exchange between two SYNCs, not a cycle of the control loop
@@ -132,16 +128,13 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
     stamps = np.array(listener.timestamps)
     periods = np.diff(stamps)
     jitter = np.abs(periods - period_s)
-    late = np.flatnonzero(periods > 1.5 * period_s)
-    on_stalls = sum(machine.report.overlapping(stamps[i], stamps[i + 1]) for i in late)
+    missed = int(np.sum(periods > 1.5 * period_s))
     return {"sync_rate_hz_nominal": sync_rate_hz, "duration_s": float(stamps[-1] - stamps[0]),
             "controller": controller_name, "cycles": int(len(periods)),
             "achieved_rate_hz": float(len(periods) / (stamps[-1] - stamps[0])),
             "jitter_p50_ms": float(1e3 * np.percentile(jitter, 50)),
             "jitter_p99_ms": float(1e3 * np.percentile(jitter, 99)),
-            "missed_cycles": int(len(late)), "longest_period_ms": float(1e3 * periods.max()),
-            "missed_during_machine_stalls": int(on_stalls), "machine_stalls": len(machine.report.stalls),
-            "machine_stall_longest_ms": machine.report.longest_ms, "machine_probe": machine.report.scheduling,
+            "missed_cycles": missed, "longest_period_ms": float(1e3 * periods.max()),
             "bus_load_mean": float(load.mean_load), "bus_load_max": float(load.max_load),
             "bus_bitrate_bit_s": int(load.bitrate_bit_s), "cycles_over_bus_capacity": len(load.overloaded),
             "rms_tip_error_mm": rms_tip_error_mm, "plant_rate_hz": plant_rate_hz, "stopped": stopped,

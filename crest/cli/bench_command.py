@@ -10,6 +10,7 @@ from control.benchmark import controller_cycle_times
 from crest.bench import model_bench, plant_bench, stack_bench, view_bench
 from crest.cli.common_options import check_output
 from crest.bench.machine_info import machine_info
+from crest.bench.machine_stalls import PROBE_PERIOD_S, PROBE_PRIORITY, machine_floor
 from crest.gap.benchmark import GOAL_S, diagnosis_benchmarks
 from model import CatheterParams
 
@@ -28,7 +29,8 @@ def add_parser(sub) -> None:
     parser.add_argument("--stack-seconds", type=float, default=60.0,
                         help="duration of each full-stack run (default 60): 500 Hz and 1 kHz SYNC with the testbed "
                              "in a process of its own, and 500 Hz with it in the master's process, each with the "
-                             "threads at --realtime-priority; 500 Hz across processes also under the normal scheduler")
+                             "threads at --realtime-priority; 500 Hz across processes also under the normal scheduler; "
+                             "first, as long, the machine's own stalls seen by an idle real-time process")
     parser.add_argument("--realtime-priority", type=int, default=STACK_REALTIME_PRIORITY, choices=range(1, 100),
                         metavar="1..99",
                         help=f"full stack: the SCHED_FIFO priority of both processes' threads (default "
@@ -61,6 +63,7 @@ def run(args: argparse.Namespace) -> int:
         "controllers": lambda: controller_cycle_times(params),
         "rod_plant": lambda: plant_bench.rod_plant(),
         "full_stack": lambda: {
+            "machine_floor": machine_floor_result(args.stack_seconds, args.realtime_priority),
             **{f"{rate:.0f}_hz_testbed_process": stack_bench.full_stack(
                 rate, args.stack_seconds, testbed_process=True, realtime_priority=args.realtime_priority)
                for rate in (500.0, 1000.0)},
@@ -84,6 +87,14 @@ def run(args: argparse.Namespace) -> int:
     print(format_table(results))
     print(f"results written to {path}")
     return 0
+
+
+def machine_floor_result(duration_s: float, stack_priority: int) -> dict:
+    """The machine's own stalls (crest.bench.machine_stalls), probed above the stack's priority."""
+    report = machine_floor(duration_s, min(99, max(PROBE_PRIORITY, stack_priority + 1)))
+    return {"duration_s": duration_s, "period_s": PROBE_PERIOD_S, "probe": report.scheduling,
+            "wakeups": report.wakeups, "stalls_over_0_5_ms": report.longer_than(0.0005),
+            "stalls_over_1_ms": report.longer_than(0.001), "longest_ms": report.longest_ms}
 
 
 def format_table(results: dict) -> str:
@@ -115,14 +126,19 @@ def format_table(results: dict) -> str:
                      f"{r['real_time_factor_at_100_hz']:.1f}x real time at 100 Hz "
                      f"({r['step_rate_per_cpu_s']:.0f} steps per CPU second)",
                      f">= {r['goal_step_rate_hz']:.0f} steps/s", r["step_rate_hz"] >= r["goal_step_rate_hz"]))
-    for key, r in results.get("full_stack", {}).items():
+    stacks = dict(results.get("full_stack", {}))
+    floor = stacks.pop("machine_floor", None)
+    if floor is not None:
+        rows.append((f"Machine floor: an idle process at {floor['probe']} waking every "
+                     f"{1e3 * floor['period_s']:g} ms for {floor['duration_s']:.0f} s, just before the full stack",
+                     f"{floor['stalls_over_1_ms']} stalls over 1 ms (a missed cycle at 500 Hz), "
+                     f"{floor['stalls_over_0_5_ms']} over 0.5 ms, longest {floor['longest_ms']:.1f} ms",
+                     "-", None))
+    for key, r in stacks.items():
         rows.append((f"Full stack at {r['sync_rate_hz_nominal']:.0f} Hz SYNC, {r['duration_s']:.0f} s, testbed in "
                      f"{r['testbed']}; master: {r['master_scheduling']}, testbed: {r['testbed_scheduling']}",
                      f"{r['achieved_rate_hz']:.0f} Hz, jitter p50 {r['jitter_p50_ms']:.2f} / p99 "
-                     f"{r['jitter_p99_ms']:.2f} ms, {r['missed_cycles']} missed "
-                     f"({r['missed_during_machine_stalls']} of them while the machine stalled: "
-                     f"{r['machine_stalls']} stalls, longest {r['machine_stall_longest_ms']:.1f} ms, for an idle "
-                     f"probe at {r['machine_probe']}), bus load "
+                     f"{r['jitter_p99_ms']:.2f} ms, {r['missed_cycles']} missed, bus load "
                      f"{100 * r['bus_load_mean']:.0f}% of {r['bus_bitrate_bit_s'] / 1e6:g} Mbit/s"
                      + (f"; stopped: {r['stopped']}" if r["stopped"] else ""),
                      "rate held, 0 missed, p99 <= 1 ms",
