@@ -25,6 +25,7 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 
 from model.effects.catalog import EFFECTS
+from model.gap.base_drift import base_drift, describe_drift
 from model.gap.calibration import ModelFit, calibrate_base, rmse_mm, tip_errors
 from model.gap.cc_calibration import calibrate_constant_curvature
 from model.gap.candidates import (CANDIDATE_ITERATIONS, CONTINUE, EXPLORE, PROBE, CandidateResult, FitTask,
@@ -208,6 +209,7 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
     after_rmse = rmse_mm([after_stack])
     after_where = breakdown(found, after_stack)
     unexplained = not final and is_significant_residual(base_rmse, noise)
+    drift = base_drift(prior, after_fit.params)
     verdict = {
         "effect": chosen[0].effects[0] if chosen else UNEXPLAINED if unexplained else "none",
         "effects": list(final.effects) if final else [],
@@ -219,7 +221,8 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
         "params": final.fit.effect_params() if final else {},
         "shrink_by_region": shrink_by_region(found, base_stack, after_stack) if final else [],
         "base_parameter_change": _base_change(baseline, final.fit) if final else [],
-        "residual": describe(after_signature, after_where, after_rmse),
+        "residual": describe(after_signature, after_where, after_rmse) + describe_drift(drift),
+        "base_drift": drift,
         "residual_concentrated": [row["region"] for row in concentrated(after_where)],
         "model_form_rms_mm": model_form_rms_mm(after_rmse, noise),
         "rejected": [] if final else [{"effect": r.effects[0], "reasons": rejections(r)} for r in singles[:3]],
