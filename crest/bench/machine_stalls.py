@@ -34,8 +34,8 @@ READY = "ready"
 
 @dataclass(frozen=True)
 class StallReport:
-    """What the probe saw: its scheduling, its wake-ups, and each stall as (start_s, end_s) on
-    time.time()'s clock (the clock of python-can's frame timestamps)."""
+    """What the probe saw: its scheduling, its wake-ups, and each stall (a wake-up more than
+    STALL_THRESHOLD_S late) as (start_s, end_s) on time.time()'s clock."""
 
     scheduling: str
     wakeups: int

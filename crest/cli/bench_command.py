@@ -10,7 +10,7 @@ from control.benchmark import controller_cycle_times
 from crest.bench import model_bench, plant_bench, stack_bench, view_bench
 from crest.cli.common_options import check_output
 from crest.bench.machine_info import machine_info
-from crest.bench.machine_stalls import PROBE_PERIOD_S, PROBE_PRIORITY, machine_floor
+from crest.bench.machine_stalls import PROBE_PERIOD_S, PROBE_PRIORITY, STALL_THRESHOLD_S, machine_floor
 from crest.gap.benchmark import GOAL_S, diagnosis_benchmarks
 from model import CatheterParams
 
@@ -93,7 +93,7 @@ def machine_floor_result(duration_s: float, stack_priority: int) -> dict:
     """The machine's own stalls (crest.bench.machine_stalls), probed above the stack's priority."""
     report = machine_floor(duration_s, min(99, max(PROBE_PRIORITY, stack_priority + 1)))
     return {"duration_s": duration_s, "period_s": PROBE_PERIOD_S, "probe": report.scheduling,
-            "wakeups": report.wakeups, "stalls_over_0_5_ms": report.longer_than(0.0005),
+            "wakeups": report.wakeups, "stalls": len(report.stalls), "stall_threshold_s": STALL_THRESHOLD_S,
             "stalls_over_1_ms": report.longer_than(0.001), "longest_ms": report.longest_ms}
 
 
@@ -132,7 +132,8 @@ def format_table(results: dict) -> str:
         rows.append((f"Machine floor: an idle process at {floor['probe']} waking every "
                      f"{1e3 * floor['period_s']:g} ms for {floor['duration_s']:.0f} s, just before the full stack",
                      f"{floor['stalls_over_1_ms']} stalls over 1 ms (a missed cycle at 500 Hz), "
-                     f"{floor['stalls_over_0_5_ms']} over 0.5 ms, longest {floor['longest_ms']:.1f} ms",
+                     f"{floor['stalls']} over {1e3 * floor['stall_threshold_s']:g} ms, longest "
+                     f"{floor['longest_ms']:.1f} ms",
                      "-", None))
     for key, r in stacks.items():
         rows.append((f"Full stack at {r['sync_rate_hz_nominal']:.0f} Hz SYNC, {r['duration_s']:.0f} s, testbed in "
