@@ -37,7 +37,9 @@ class Resolution:
         at a tendon's reversal or slack/taut switch can end on a spurious equilibrium; retried in
         halves it follows the plant. With the default 12, a 1e-9 relative change of EI changed
         one held-out RMSE from 0.25 to 0.33 mm (a 3 mm tip jump for a few samples) and a
-        switched-off effect (1e-9) to 0.64 mm; with 8, all stayed at 0.25 mm.
+        switched-off effect (1e-9) to 0.64 mm; with 8, all stayed at 0.25 mm. Since the kernel
+        locates where a slack tendon tightens (quasi_static_kernel.run_path), the cap no longer
+        decides that either: caps 8 and 12 follow the same branch (tests/model/test_tightening.py).
     fit_rate_hz: recordings are decimated to about this rate for fitting and evaluation; the
         smooth excitation loses nothing at 10 Hz.
     max_fit_samples: fits use at most this many (decimated) training samples in total, each

@@ -37,11 +37,14 @@ def test_calibration_recovers_known_parameters_from_noiseless_data():
     # together changes them only through the tendon stiffness and the weight. So the ratios come
     # back, not the scale (a solver change that only shortened Newton's path moved EI from 1107 to
     # 1035 N*mm^2, both under 0.01 mm RMS with EI/sigma and EI/Fsc within 1%), and the statistics say
-    # so: EI and Fsc correlate strongly. A tension log would fix the scale.
+    # so: EI correlates strongly with the other force scales. Which pair carries most of that
+    # direction is the solver's detail: EI-Fsc 0.90 and EI-EA 0.23 before the kernel located where
+    # tendons tighten, 0.75 and 0.87 after (fit errors 0.006 and 0.0015 mm). A tension log would fix the scale.
     p = fit.params
     assert p.bending_stiffness_nmm2 / p.sigma_n_per_mm2 == pytest.approx(1150.0 / 0.7, rel=0.05)
     assert p.bending_stiffness_nmm2 / p.fsc_n_per_mm == pytest.approx(1150.0 / 0.0065, rel=0.05)
-    assert fit.correlation[fit.names.index("bending_stiffness_nmm2")][fit.names.index("fsc_n_per_mm")] > 0.8
+    ei = fit.names.index("bending_stiffness_nmm2")
+    assert max(fit.correlation[ei][fit.names.index(name)] for name in ("axial_stiffness_n", "fsc_n_per_mm")) > 0.8
     assert fit.params.mu == pytest.approx(0.26, abs=0.03)
     assert fit.params.sigma_n_per_mm2 == pytest.approx(0.7, rel=0.3)
     assert fit.params.fsc_n_per_mm == pytest.approx(0.0065, rel=0.3)
