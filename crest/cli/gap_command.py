@@ -170,6 +170,10 @@ def format_family_score(family: str, score: dict) -> str:
              f"{pct(score['top1_single_above_detection'])} (target >= 90 %)",
              f"clean cases with no catalog effect named ('none' or 'unexplained'): "
              f"{pct(score['no_catalog_effect_clean'])} (target >= 80 %)"]
+    if counts.get("single_with_visible_size"):
+        lines.append(f"top-1 above the detection limit by the effect's visible part, what the calibrated model "
+                     f"cannot absorb ({counts['single_above_visible_limit']} cases): "
+                     f"{pct(score['top1_single_above_visible_limit'])}")
     if counts["out_of_catalog"]:
         lines.append(f"out-of-catalog cases 'unexplained': {pct(score['unexplained_out_of_catalog'])} "
                      f"(target >= 80 %); a catalog effect named in {score['catalog_effect_out_of_catalog']} of "

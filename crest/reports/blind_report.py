@@ -5,7 +5,8 @@
   and one line per case;
 - confusion_<family>.png: the confusion matrix as a heat map;
 - detection_<family>.png: top-1 per effect against the effect's size relative to the baseline
-  residual (the detection-limit curve);
+  residual (the detection-limit curve); on the rod family also against the effect's visible part
+  (`crest.gap.visible_effect`);
 - shrink.png: the predicted shrink against the oracle shrink, one point per case with an effect.
 """
 from __future__ import annotations
@@ -24,7 +25,8 @@ def write_blind_report(result: dict, out_dir: Path | str) -> Path:
     out.mkdir(parents=True, exist_ok=True)
     for family, score in result["score"].items():
         save_png(_confusion_figure(score["confusion"]), out / f"confusion_{family}.png")
-        save_png(_detection_figure(score["detection_curve"]), out / f"detection_{family}.png")
+        save_png(_detection_figure(score["detection_curve"], score.get("visible_detection_curve")),
+                 out / f"detection_{family}.png")
     save_png(_shrink_figure(result["cases"]), out / "shrink.png")
     path = out / "blind_benchmark.md"
     path.write_text(markdown(result))
@@ -60,18 +62,20 @@ def markdown(result: dict) -> str:
     for family, score in result["score"].items():
         lines += _family_markdown(family, score)
     lines += ["## Cases", "",
-              "| family | case | truth | verdict | effect size mm | size / residual | noise mm | shrink | oracle |",
-              "|---|---|---|---|---|---|---|---|---|"]
+              "| family | case | truth | verdict | effect size mm | size / residual | visible / residual | noise mm | "
+              "shrink | oracle |",
+              "|---|---|---|---|---|---|---|---|---|---|"]
     for row in result["cases"]:
         truth = "+".join(row["truth"]) or "none"
         family = row.get("family", "dahl")
         if "predicted_shrink" not in row:
             lines.append(f"| {family} | {row['case']} | {truth} | {row.get('skipped') or row.get('no_result')} "
-                         "| | | | | |")
+                         "| | | | | | |")
             continue
         oracle = f"{row['oracle_shrink']:.2f}" if _has_oracle(row) else ("failed" if "oracle_shrink" in row else "-")
+        visible = f"{row['visible_relative_size']:.2f}" if "visible_relative_size" in row else "-"
         lines.append(f"| {family} | {row['case']} | {truth} | {'+'.join(row['predicted_effects']) or row['predicted']} | "
-                     f"{row['effect_rms_mm']:.2f} | {row.get('relative_size', 0.0):.2f} | {row['noise_mm']:.2f} | "
+                     f"{row['effect_rms_mm']:.2f} | {row.get('relative_size', 0.0):.2f} | {visible} | {row['noise_mm']:.2f} | "
                      f"{row['predicted_shrink']:.2f} | {oracle} |")
     return "\n".join(lines) + "\n"
 
@@ -85,6 +89,9 @@ def _family_markdown(family: str, score: dict) -> list[str]:
         f"| top-1 on single effects | {_pct(score['top1_single'])} of {counts['single']} | - |",
         f"| top-1 above the detection limit | {_pct(score['top1_single_above_detection'])} of "
         f"{counts['single_above_detection']} | >= 90% |",
+        *([f"| top-1 above the detection limit by the effect's visible part (what the calibrated model cannot absorb) | "
+           f"{_pct(score['top1_single_above_visible_limit'])} of {counts['single_above_visible_limit']} | - |"]
+          if counts.get("single_with_visible_size") else []),
         f"| top-1 where the effect moves the tip more than the tracker noise | "
         f"{_pct(score['top1_single_above_noise'])} of {counts['single'] - counts['single_below_noise']} | - |",
         f"| clean cases with no catalog effect (`none` or `unexplained`) | {_pct(score['no_catalog_effect_clean'])} "
@@ -106,26 +113,40 @@ def _family_markdown(family: str, score: dict) -> list[str]:
               "### Detection limit: top-1 against effect size / baseline residual", "",
               f"![detection limit](detection_{family}.png)", "",
               "| effect | size / residual | cases | top-1 |", "|---|---|---|---|"]
-    for effect_id, bins in score["detection_curve"].items():
-        for row in bins:
-            high = "inf" if row["ratio_high"] is None else f"{row['ratio_high']:g}"
-            lines.append(f"| {effect_id} | {row['ratio_low']:g}-{high} | {row['cases']} | {_pct(row['top1'])} |")
+    lines += _curve_rows(score["detection_curve"])
+    if counts.get("single_with_visible_size"):
+        lines += ["", "By the effect's visible part (the detection figure's right panel):", "",
+                  "| effect | visible / residual | cases | top-1 |", "|---|---|---|---|"]
+        lines += _curve_rows(score["visible_detection_curve"])
     return lines + [""]
 
 
-def _detection_figure(curve: dict) -> Figure:
-    figure = new_figure(6.0, 4.0)
-    ax = figure.subplots()
+def _curve_rows(curve: dict) -> list[str]:
+    lines = []
     for effect_id, bins in curve.items():
-        if bins:
-            centres = [(row["ratio_low"] + (row["ratio_high"] if row["ratio_high"] is not None
-                                            else 1.5 * max(row["ratio_low"], 1.0))) / 2 for row in bins]
-            ax.plot(centres, [row["top1"] for row in bins], marker="o", label=effect_id)
-    ax.set_xlabel("effect size / baseline residual (held-out RMS)")
-    ax.set_ylabel("top-1")
-    ax.set_ylim(-0.05, 1.05)
-    if curve:
-        ax.legend(fontsize=7)
+        for row in bins:
+            high = "inf" if row["ratio_high"] is None else f"{row['ratio_high']:g}"
+            lines.append(f"| {effect_id} | {row['ratio_low']:g}-{high} | {row['cases']} | {_pct(row['top1'])} |")
+    return lines
+
+
+def _detection_figure(curve: dict, visible_curve: dict | None = None) -> Figure:
+    """Top-1 against the effect's raw size; beside it, where known (rod), against its visible part."""
+    panels = [(curve, "effect size / baseline residual (held-out RMS)")]
+    if visible_curve and any(visible_curve.values()):
+        panels.append((visible_curve, "visible part / baseline residual"))
+    figure = new_figure(6.0 * len(panels), 4.0)
+    for ax, (bins_by_effect, label) in zip(np.atleast_1d(figure.subplots(1, len(panels))), panels):
+        for effect_id, bins in bins_by_effect.items():
+            if bins:
+                centres = [(row["ratio_low"] + (row["ratio_high"] if row["ratio_high"] is not None
+                                                else 1.5 * max(row["ratio_low"], 1.0))) / 2 for row in bins]
+                ax.plot(centres, [row["top1"] for row in bins], marker="o", label=effect_id)
+        ax.set_xlabel(label)
+        ax.set_ylabel("top-1")
+        ax.set_ylim(-0.05, 1.05)
+        if bins_by_effect:
+            ax.legend(fontsize=7)
     return figure
 
 

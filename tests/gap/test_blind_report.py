@@ -43,5 +43,20 @@ def test_a_case_whose_oracle_failed_is_reported_as_failed_and_left_out_of_the_sh
     del failed["shrink_error_pp"]        # run_case scores no shrink error without a finite oracle
     rows = result()["cases"] + [failed]
     path = write_blind_report({**result(), "cases": rows, "score": {"dahl": score(rows)}}, tmp_path / "blind")
-    assert "| dahl | 4 | tendon_elasticity | tendon_elasticity | 0.80 | 0.80 | 0.10 | 0.49 | failed |" in path.read_text()
+    assert "| dahl | 4 | tendon_elasticity | tendon_elasticity | 0.80 | 0.80 | - | 0.10 | 0.49 | failed |" in path.read_text()
     assert (tmp_path / "blind" / "shrink.png").stat().st_size > 1000
+
+
+def test_the_rod_report_adds_the_detection_limit_by_the_effects_visible_part(tmp_path):
+    absorbed = dict(case(0, "single", ["lumen_compression"], None, 0.0, 0.0), relative_size=5.1,
+                    visible_effect_mm=0.0, visible_relative_size=0.0, above_visible_limit=False)
+    seen = dict(case(1, "single", ["backlash"], "backlash", 0.95, 0.95), relative_size=0.98,
+                visible_effect_mm=11.9, visible_relative_size=0.71, above_visible_limit=True)
+    rows = [dict(r, family="rod") for r in (absorbed, seen)]
+    text = write_blind_report({**result(), "cases": rows, "score": {"rod": score(rows)}}, tmp_path / "blind").read_text()
+    assert "| top-1 above the detection limit | 50% of 2 | >= 90% |" in text
+    assert ("| top-1 above the detection limit by the effect's visible part (what the calibrated model cannot "
+            "absorb) | 100% of 1 | - |") in text
+    assert "| lumen_compression | 0-0.1 | 1 | 0% |" in text and "| backlash | 0.7-1 | 1 | 100% |" in text
+    assert "| rod | 0 | lumen_compression | none | 0.80 | 5.10 | 0.00 | 0.10 | 0.00 | 0.00 |" in text
+    assert (tmp_path / "blind" / "detection_rod.png").stat().st_size > 1000
