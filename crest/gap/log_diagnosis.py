@@ -5,6 +5,7 @@ hidden effect) is not an input.
 """
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Sequence
 from concurrent.futures import Executor
 from pathlib import Path
@@ -12,8 +13,12 @@ from pathlib import Path
 from crest.gap.fit_executor import local_executor
 from crest.gap.log_recordings import load_recordings
 from model import CatheterParams
-from model.gap.calibration import FAST_TENDON_SPEED_MM_S, ModelFit, calibrate_base, fast_travel_share, is_fast
+from model.gap.calibration import (FAST_TENDON_SPEED_MM_S, ModelFit, calibrate_base, fast_travel_share, is_fast,
+                                   rmse_mm, tip_errors)
 from model.gap.diagnosis import DiagnosisSettings, diagnose
+from model.gap.force_scale import scaled_to_tensions
+from model.gap.free_parameters import ParameterLayout
+from model.gap.simulation import catheter_for
 
 
 def prior_catheter(catheter_toml: Path | str | None) -> CatheterParams:
@@ -24,7 +29,10 @@ def prior_catheter(catheter_toml: Path | str | None) -> CatheterParams:
 def calibrate_logs(train: Sequence[Path | str], catheter_toml: Path | str | None = None,
                    settings: DiagnosisSettings = DiagnosisSettings(),
                    progress: Callable[[str], None] | None = None, fit_dynamics: bool | None = False) -> ModelFit:
-    """Fit the base model to the training logs (geometry from their sidecars).
+    """Fit the base model to the training logs (geometry from their sidecars), then set its force
+    scale from the logs' drive tensions where they have them (`model.gap.force_scale`: the tips do
+    not fix it, a controller planning tensions needs it); the training RMSE and flags are those of
+    the rescaled model.
 
     fit_dynamics: also fit the damping time and inertia scale; None: when the logs are fast
     (model.gap.calibration.is_fast).
@@ -38,10 +46,22 @@ def calibrate_logs(train: Sequence[Path | str], catheter_toml: Path | str | None
             f"{FAST_TENDON_SPEED_MM_S:g} mm/s: "
             + ("fast, fitting the damping time and inertia scale too" if fit_dynamics else "quasi-static fit"))
     with local_executor(settings.workers) as pool:
-        return calibrate_base(recordings, prior, resolution=settings.resolution,
-                              max_iterations=settings.baseline_iterations, executor=pool,
-                              on_fit=lambda done, total: say(f"base model: {done}/{total} starts fitted"),
-                              fit_dynamics=fit_dynamics)
+        fit = calibrate_base(recordings, prior, resolution=settings.resolution,
+                             max_iterations=settings.baseline_iterations, executor=pool,
+                             on_fit=lambda done, total: say(f"base model: {done}/{total} starts fitted"),
+                             fit_dynamics=fit_dynamics)
+    prepared = settings.resolution.prepare_training(recordings)
+    scaled = scaled_to_tensions(fit, prepared, settings.resolution)
+    if scaled is None:
+        say("the logs hold no drive tensions: the force scale (EI, EA, sigma and Fsc together) is left where "
+            "the tip fit ended; the tips do not fix it")
+        return fit
+    fit, scale = scaled
+    say(f"force scale from the logged drive tensions: x{scale:.3f} on EI, EA, sigma and Fsc")
+    layout = ParameterLayout(catheter_for(prior, prepared), (), True, fit_dynamics)
+    flags = tuple(flag for parameter, value in zip(layout.parameters, fit.values)
+                  if (flag := parameter.flag(float(value))) is not None)
+    return dataclasses.replace(fit, flags=flags, train_rmse_mm=rmse_mm(tip_errors(fit, prepared, settings.resolution)))
 
 
 def diagnose_logs(train: Sequence[Path | str], holdout: Sequence[Path | str],
