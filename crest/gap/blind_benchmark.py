@@ -391,20 +391,29 @@ def run_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Excitat
                 executor.submit(rod_oracle_shrink, *oracle_args).result()
             visible = visible_effect_mm(*load_recordings([holdout]), *load_recordings([reference]), prior, settings,
                                         executor)
-            visible_relative = visible / row["baseline_holdout_rmse_mm"] if row["baseline_holdout_rmse_mm"] > 0 else 0.0
+            visible_relative = _relative(visible, row)
             row.update(visible_effect_mm=visible, visible_relative_size=visible_relative,
-                       above_visible_limit=visible >= math.sqrt(3.0) * case.tracker_noise_mm
-                       and visible_relative >= DETECTION_RATIO)
+                       above_visible_limit=_above_limit(visible, visible_relative, case.tracker_noise_mm))
     else:
         effect_rms_mm = 0.0
-    relative = effect_rms_mm / row["baseline_holdout_rmse_mm"] if row["baseline_holdout_rmse_mm"] > 0 else 0.0
+    relative = _relative(effect_rms_mm, row)
     row.update(effect_rms_mm=effect_rms_mm, relative_size=relative,
                above_noise=effect_rms_mm >= math.sqrt(3.0) * case.tracker_noise_mm,
-               above_detection_limit=effect_rms_mm >= math.sqrt(3.0) * case.tracker_noise_mm
-               and relative >= DETECTION_RATIO)
+               above_detection_limit=_above_limit(effect_rms_mm, relative, case.tracker_noise_mm))
     if "oracle_shrink" in row and math.isfinite(row["oracle_shrink"]):
         row["shrink_error_pp"] = 100.0 * abs(verdict["shrink"] - row["oracle_shrink"])
     return row
+
+
+def _relative(size_mm: float, row: dict) -> float:
+    """An effect's size relative to the case's baseline residual (held-out RMSE)."""
+    return size_mm / row["baseline_holdout_rmse_mm"] if row["baseline_holdout_rmse_mm"] > 0 else 0.0
+
+
+def _above_limit(size_mm: float, relative: float, noise_mm: float) -> bool:
+    """The detection limit: above the tracker noise floor (sqrt(3) sigma) and at least DETECTION_RATIO of
+    the baseline residual."""
+    return size_mm >= math.sqrt(3.0) * noise_mm and relative >= DETECTION_RATIO
 
 
 def candidate_summary(candidate: dict) -> dict:
