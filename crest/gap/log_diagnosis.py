@@ -57,10 +57,9 @@ def calibrate_logs(train: Sequence[Path | str], catheter_toml: Path | str | None
             "the tip fit ended; the tips do not fix it")
         return fit
     fit, scale = scaled
-    say(f"force scale from the logged drive tensions: x{scale:.3f} on EI, EA, sigma and Fsc")
-    layout = ParameterLayout(catheter_for(prior, prepared), (), True, fit_dynamics)
-    flags = tuple(flag for parameter, value in zip(layout.parameters, fit.values)
-                  if (flag := parameter.flag(float(value))) is not None)
+    say(f"force scale from the logged drive tensions: x{scale:.3f} on EI, EA, sigma and Fsc"
+        + (" and the inertia scale" if fit_dynamics else ""))
+    flags = ParameterLayout(catheter_for(prior, prepared), (), True, fit_dynamics).flags(fit.values)
     return dataclasses.replace(fit, flags=flags, train_rmse_mm=rmse_mm(tip_errors(fit, prepared, settings.resolution)))
 
 

@@ -11,7 +11,7 @@ the bending stiffness:
 A fitted ratio more than DRIFT_FACTOR from the prior's means the baseline took up something the
 prior's catheter does not have. On the rod plant a soft proximal sheath (the rod's lumen
 compression) left no held-out error above that of clean cases; the baseline had absorbed it with
-an EA/EI about 20 times below the prior's (README, "Gravity across the insertion axis"). A prior
+an EA/EI 20-27 times below the prior's (README, "Sim-to-real gap diagnosis"). A prior
 that describes another device altogether (a real robot measured against the default catheter)
 drifts too; the report then says that the prior does not describe it.
 """

@@ -234,7 +234,7 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
     std_z, correlation = _statistics(result.jac, result.fun, len(result.x))
     physical = np.array([p.from_z(z) for p, z in zip(layout.parameters, result.x)])
     std = np.array([p.std(z, s) for p, z, s in zip(layout.parameters, result.x, std_z)])
-    flags = tuple(f for p, v in zip(layout.parameters, physical) if (f := p.flag(float(v))) is not None)
+    flags = layout.flags(physical)
     train_rmse = float(np.sqrt(np.sum(result.fun ** 2) / max(1, len(result.fun) // 3)))
     return ModelFit(params=params, zero_offsets_mm=tuple(float(v) for v in zero), effects=values,
                     names=layout.names, values=tuple(float(v) for v in physical), std=tuple(float(s) for s in std),

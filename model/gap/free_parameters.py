@@ -162,6 +162,11 @@ class ParameterLayout:
     def names(self) -> tuple[str, ...]:
         return tuple(p.name for p in self.parameters)
 
+    def flags(self, values: Sequence[float]) -> tuple[str, ...]:
+        """Why each fitted value (physical units, layout order) is suspicious (`FreeParameter.flag`)."""
+        return tuple(flag for parameter, value in zip(self.parameters, values)
+                     if (flag := parameter.flag(float(value))) is not None)
+
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         params = self.parameters
         return np.array([p.to_z(p.lower) for p in params]), np.array([p.to_z(p.upper) for p in params])
