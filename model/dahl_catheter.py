@@ -187,7 +187,7 @@ class DahlCatheter:
             insertion_mm = float(self.state.applied_insertion_mm[0])
         tendons, insertion = self._validated(np.asarray(tendons_mm, dtype=float).reshape(1, -1),
                                              np.asarray([insertion_mm], dtype=float).reshape(-1))
-        return self._run(tendons, insertion, np.inf)[0]
+        return self._run(tendons, insertion, np.inf)[0][0]
 
     def run(self, tendons_mm, insertion_mm=None, dt_s: float = 0.01,
             max_solver_iterations: float = math.inf) -> np.ndarray:
@@ -198,6 +198,11 @@ class DahlCatheter:
         max_solver_iterations: SolverBudgetExceeded (state unchanged) as soon as the run has taken
         more Newton iterations; a measure of work that, unlike time, does not depend on the machine.
         """
+        return self.run_with_tension(tendons_mm, insertion_mm, dt_s, max_solver_iterations)[0]
+
+    def run_with_tension(self, tendons_mm, insertion_mm=None, dt_s: float = 0.01,
+                         max_solver_iterations: float = math.inf) -> tuple[np.ndarray, np.ndarray]:
+        """`run`, and the tendon tensions at the drives after each sample [T, 4] in N (what the drives log)."""
         tendons = np.asarray(tendons_mm, dtype=float)
         if insertion_mm is None:
             insertion_mm = np.full(len(tendons), float(self.state.applied_insertion_mm[0]))
@@ -211,16 +216,17 @@ class DahlCatheter:
         return self._run(tendons, insertion, float(dt_s), float(max_solver_iterations))
 
     def _run(self, tendons: np.ndarray, insertion: np.ndarray, dt_s: float,
-             max_solver_iterations: float = math.inf) -> np.ndarray:
+             max_solver_iterations: float = math.inf) -> tuple[np.ndarray, np.ndarray]:
         before = self.state.copy()
         s = self.state
         tips = np.empty((len(tendons), 3))
+        tension = np.empty((len(tendons), 4))
         done = run_path(tendons, insertion, dt_s, self.max_tendon_step_mm, self.max_insertion_step_mm,
                         self.max_newton_iterations, max_solver_iterations, self._kernel_params,
                         self._kernel_effects, self._point_loads, s.applied_tendon_mm, s.applied_insertion_mm,
                         s.friction_n, s.sliding_mm, s.last_step_mm, s.tension_n, s.last_tension_step_n,
                         s.bend_rad, s.compression_mm, s.tip_tension_n, s.drive_tension_n, s.slack, s.points_mm,
-                        s.frames, s.diagnostics, tips,
+                        s.frames, s.diagnostics, tips, tension,
                         self.max_time_step_s, s.bend_rate_rad_s, s.drive_creep_mm)
         if done < len(tendons):
             self.state = before
@@ -230,7 +236,7 @@ class DahlCatheter:
             self.state = before
             raise ModelSolverError(f"the catheter model diverged (non-finite state) with {self.params}; "
                                    "the state is unchanged. Check the parameters' ranges.")
-        return tips + self._tracker_offset_mm
+        return tips + self._tracker_offset_mm, tension
 
     def _validated(self, tendons: np.ndarray, insertion: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Check shapes, finiteness and ranges before anything touches the state."""

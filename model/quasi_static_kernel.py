@@ -763,8 +763,9 @@ def remap_to_length(old_length, new_length, friction, sliding, last_step, tensio
 def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_step_mm, max_iterations,
              iteration_budget, params, effects, point_loads, applied_tendon_mm, applied_insertion_mm, friction,
              sliding, last_step, tension, last_tension_step, bend, compression, tip_tension, drive_tension, slack,
-             points, frames, scalars, tips_out, max_time_step_s, bend_rate, creep):
-    """Drive the model along a sampled input path; tips_out[t] is the tip after sample t.
+             points, frames, scalars, tips_out, drive_tension_out, max_time_step_s, bend_rate, creep):
+    """Drive the model along a sampled input path; tips_out[t] is the tip and drive_tension_out[t]
+    the tendon tensions at the drives after sample t.
 
     Returns the number of samples done: all of them, unless the Newton iterations of this call
     exceed iteration_budget (inf: no budget), where it stops at once (mid-sample, the state then
@@ -859,4 +860,6 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
         nb = points.shape[0] - 1
         for a in range(3):
             tips_out[t, a] = points[nb, a]
+        for k in range(4):
+            drive_tension_out[t, k] = drive_tension[k]
     return n_samples

@@ -51,11 +51,7 @@ def record_plant_log(path: Path | str, trajectory: Trajectory, plant: Plant, noi
     u = tendon_pos - np.asarray(plant.zero_offsets_mm)
     dt_s = trajectory.period_s
     n = len(trajectory)
-    tips = np.empty((n, 3))
-    force = np.empty((n, 4))
-    for t in range(n):
-        tips[t] = catheter.run(u[t:t + 1], insertion_pos[t:t + 1], dt_s)[0]
-        force[t] = catheter.drive_tension_n
+    tips, force = catheter.run_with_tension(u, insertion_pos, dt_s)
     tips += rng.normal(0.0, noise.tip_mm, tips.shape)
     tips[rng.random(n) < noise.dropout_fraction] = np.nan
     force += rng.normal(0.0, noise.tendon_force_n, force.shape)

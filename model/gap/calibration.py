@@ -2,9 +2,10 @@
 
 Least squares over the tip error of every valid sample of the training recordings,
 
-    minimise  sum_t |tip_model(t; p) - tip_measured(t)|^2,   p in bounds,
+    minimise  sum_t |tip_model(t; p) - tip_measured(t)|^2 + r_scale(p)^2,   p in bounds,
 
-with the model driven by the measured tendon and insertion positions (scipy.optimize.least_squares,
+where r_scale is 0 unless the recordings logged drive tensions, and then holds the model tensions'
+scale against the logged ones (`tension_scale`: the one direction the tips leave free), with the model driven by the measured tendon and insertion positions (scipy.optimize.least_squares,
 trust-region reflective, forward-difference Jacobian), warm-started from the given parameters.
 
 Between good starting parameters the cost has ridges (where a parameter change flips a tendon
@@ -38,8 +39,9 @@ from model.dahl_catheter import ModelSolverError, SolverBudgetExceeded
 from model.effects.catalog import combined_terms, effect
 from model.gap.free_parameters import ParameterLayout, base_values
 from model.gap.recording import Recording
-from model.gap.simulation import Resolution, catheter_for, predict_tips_and_work, solver_work
+from model.gap.simulation import Resolution, catheter_for, predict_run, solver_work
 from model.gap.starting_points import base_grid, base_starts
+from model.gap.tension_scale import scale_residual_mm, tension_scale
 from model.params import CatheterParams
 
 DIFF_STEP = 0.02       # finite-difference step, DIFF_STEP * max(1, |z|): far above the kernel's ~1 um solver noise
@@ -149,15 +151,21 @@ def tip_errors(fit: ModelFit, recordings: Sequence[Recording], resolution: Resol
     Newton iterations in runs that took 10-14x the start's, on parameters (mu at its bound, sigma
     6x the prior) that lowered the training RMSE by 1-2 %.
     """
+    return tip_errors_and_tensions(fit, recordings, resolution, iteration_limit)[0]
+
+
+def tip_errors_and_tensions(fit: ModelFit, recordings: Sequence[Recording], resolution: Resolution,
+                            iteration_limit: int | None = None) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """`tip_errors`, and the model's drive tensions [T, 4] per recording (infinite where the run failed)."""
     terms = fit.terms()
     zero = np.asarray(fit.zero_offsets_mm)
     budget = math.inf if iteration_limit is None else iteration_limit
-    errors = []
+    errors, tensions = [], []
     for r in recordings:
-        tips = np.full(r.tip_mm.shape, np.inf)      # unless the run ends within the limit left
+        tips, tension = np.full(r.tip_mm.shape, np.inf), np.full((len(r), 4), np.inf)   # unless the run ends
         if budget >= 0:
             try:
-                tips, work = predict_tips_and_work(fit.params, terms, zero, r, resolution, budget)
+                tips, tension, work = predict_run(fit.params, terms, zero, r, resolution, budget)
                 budget -= work
             except SolverBudgetExceeded:
                 budget = -1.0
@@ -166,12 +174,14 @@ def tip_errors(fit: ModelFit, recordings: Sequence[Recording], resolution: Resol
         error = (tips - r.tip_mm)[r.valid]
         error[~np.isfinite(error)] = np.inf
         errors.append(error)
-    return errors
+        tensions.append(tension)
+    return errors, tensions
 
 
 @dataclass
 class _Objective:
-    """Residual vector r(z) = tip_model - tip_measured over every valid sample (picklable for workers)."""
+    """Residual vector r(z): tip_model - tip_measured over every valid sample and, where the recordings
+    logged drive tensions, one last entry for the tensions' scale (`tension_scale`). Picklable for workers."""
 
     layout: ParameterLayout
     start: CatheterParams
@@ -180,10 +190,20 @@ class _Objective:
     resolution: Resolution
     iteration_limit: int | None = None
 
+    @property
+    def logged_tensions(self) -> bool:
+        return any(r.tendon_force_n is not None for r in self.prepared)
+
     def __call__(self, z: np.ndarray) -> np.ndarray:
         params, zero, values = self.layout.unpack(z, self.start, self.zero_start)
-        out = np.concatenate(tip_errors(ModelFit(params, tuple(zero), values), self.prepared, self.resolution,
-                                        self.iteration_limit)).ravel()
+        errors, tensions = tip_errors_and_tensions(ModelFit(params, tuple(zero), values), self.prepared,
+                                                   self.resolution, self.iteration_limit)
+        out = np.concatenate(errors).ravel()
+        if self.logged_tensions:
+            logged = [(model, r.tendon_force_n) for model, r in zip(tensions, self.prepared)
+                      if r.tendon_force_n is not None]
+            scale = tension_scale(*zip(*logged)) if np.all(np.isfinite(out)) else None
+            out = np.append(out, scale_residual_mm(scale, len(out) // 3))
         if not np.all(np.isfinite(out)):   # the solver failed at these parameters: make them unattractive
             out = np.full_like(out, DIVERGED_RESIDUAL_MM)
         return out
@@ -235,7 +255,8 @@ def calibrate(recordings: Sequence[Recording], start: CatheterParams, *, prior: 
     physical = np.array([p.from_z(z) for p, z in zip(layout.parameters, result.x)])
     std = np.array([p.std(z, s) for p, z, s in zip(layout.parameters, result.x, std_z)])
     flags = layout.flags(physical)
-    train_rmse = float(np.sqrt(np.sum(result.fun ** 2) / max(1, len(result.fun) // 3)))
+    tip_residuals = result.fun[:len(result.fun) - 1] if objective.logged_tensions else result.fun
+    train_rmse = float(np.sqrt(np.sum(tip_residuals ** 2) / max(1, len(tip_residuals) // 3)))
     return ModelFit(params=params, zero_offsets_mm=tuple(float(v) for v in zero), effects=values,
                     names=layout.names, values=tuple(float(v) for v in physical), std=tuple(float(s) for s in std),
                     correlation=tuple(tuple(float(c) for c in row) for row in correlation), flags=flags,

@@ -10,12 +10,10 @@ as large, 0.002 mm apart in held-out RMSE. Tips are all a diagnosis
 compares, but a controller that plans tensions (its tension limit, the testbed's safety stop) needs
 the scale: at EI 1997 the 150 deg circle was refused before motion for 39 N on one tendon.
 
-The drives log each tendon's force. With the model's drive tensions T_model at the fitted
-parameters and the measured T_meas over every sample and tendon where both are finite,
-
-    s = sum(T_model * T_meas) / sum(T_model^2),
-
-the least-squares factor between them, and `rescaled` multiplies the scaled parameters by s.
+The drives log each tendon's force. The fits already pay for a model whose tensions are off the
+logged ones' scale (`tension_scale`), but only in proportion: `crest fit` then puts the fit on that
+scale exactly. `rescaled` multiplies the scaled parameters by the least-squares factor s between
+the model's and the logged tensions (`tension_scale`).
 Since the pretension does not scale, one such step leaves part of the way (a catheter fitted twice
 too stiff came back to 1.24 times), so `scaled_to_tensions` repeats it until s is within
 SCALE_TOLERANCE of 1.
@@ -30,31 +28,22 @@ import numpy as np
 from model.gap.calibration import ModelFit
 from model.gap.recording import Recording
 from model.gap.simulation import Resolution, predict_tips_and_tension
+from model.gap.tension_scale import tension_scale
 
 SCALED = ("bending_stiffness_nmm2", "axial_stiffness_n", "sigma_n_per_mm2", "fsc_n_per_mm", "inertia_scale")
-MIN_TENSION_N = 0.5      # the logs must hold some tension for the factor to mean anything
 SCALE_TOLERANCE = 0.002
 MAX_SCALE_STEPS = 8
 
 
 def force_scale(fit: ModelFit, recordings: Sequence[Recording], resolution: Resolution) -> float | None:
-    """s = sum(T_model T_meas) / sum(T_model^2) over the recordings (at the fit resolution: decimated),
-    or None where no recording logged tensions or the model holds almost none (max below MIN_TENSION_N)."""
-    model, measured = [], []
-    for recording in recordings:
-        if recording.tendon_force_n is None:
-            continue
-        _, tension = predict_tips_and_tension(fit.params, fit.terms(), np.asarray(fit.zero_offsets_mm), recording,
-                                              resolution)
-        both = np.isfinite(tension) & np.isfinite(recording.tendon_force_n)
-        model.append(tension[both])
-        measured.append(recording.tendon_force_n[both])
-    if not model:
+    """s (`tension_scale`) over the recordings that logged tensions (at the fit resolution: decimated),
+    or None where none did or the model holds almost none."""
+    logged = [r for r in recordings if r.tendon_force_n is not None]
+    if not logged:
         return None
-    t_model, t_measured = np.concatenate(model), np.concatenate(measured)
-    if t_model.size == 0 or np.max(np.abs(t_model)) < MIN_TENSION_N:
-        return None
-    return float(t_model @ t_measured / (t_model @ t_model))
+    model = [predict_tips_and_tension(fit.params, fit.terms(), np.asarray(fit.zero_offsets_mm), r, resolution)[1]
+             for r in logged]
+    return tension_scale(model, [r.tendon_force_n for r in logged])
 
 
 def rescaled(fit: ModelFit, scale: float) -> ModelFit:

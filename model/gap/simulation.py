@@ -144,22 +144,27 @@ def predict_tips(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: 
     return _run(params, effects, zero_offsets_mm, recording, resolution, iteration_limit)[0]
 
 
-def predict_tips_and_work(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray,
-                          recording: Recording, resolution: Resolution,
-                          iteration_limit: int | None = None) -> tuple[np.ndarray, int]:
-    """`predict_tips` and the Newton iterations the run took (the unit of its limit)."""
+def predict_tips_and_tension(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray,
+                             recording: Recording, resolution: Resolution) -> tuple[np.ndarray, np.ndarray]:
+    """Model tips [T, 3] (mm) and drive tensions [T, 4] (N) after each sample."""
+    return _run(params, effects, zero_offsets_mm, recording, resolution)[:2]
+
+
+def predict_run(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray, recording: Recording,
+                resolution: Resolution, iteration_limit: int | None = None) -> tuple[np.ndarray, np.ndarray, int]:
+    """`predict_tips_and_tension` and the Newton iterations the run took (the unit of its limit)."""
     return _run(params, effects, zero_offsets_mm, recording, resolution, iteration_limit)
 
 
 def solver_work(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray,
                 recordings: Sequence[Recording], resolution: Resolution) -> int:
     """Newton iterations of the model's runs along the recordings (the unit of `predict_tips`' limit)."""
-    return sum(_run(params, effects, zero_offsets_mm, r, resolution)[1] for r in recordings)
+    return sum(_run(params, effects, zero_offsets_mm, r, resolution)[2] for r in recordings)
 
 
 def _run(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray, recording: Recording,
-         resolution: Resolution, iteration_limit: int | None = None) -> tuple[np.ndarray, int]:
-    """Tips [T, 3] and the Newton iterations they took (see `predict_tips`).
+         resolution: Resolution, iteration_limit: int | None = None) -> tuple[np.ndarray, np.ndarray, int]:
+    """Tips [T, 3], drive tensions [T, 4] and the Newton iterations they took (see `predict_tips`).
 
     The last RUN_MEMORY runs of this process are remembered by their exact inputs (parameters and
     effects by repr, which tells -0.0 from 0.0; zero offsets and the recording's inputs by their
@@ -181,21 +186,21 @@ def _run(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarr
         if known.diverged:
             raise ModelSolverError(f"the catheter model diverged (non-finite state) with {params}")
         if known.tips is not None and known.iterations <= limit:
-            return known.tips.copy(), known.iterations
+            return known.tips.copy(), known.tension.copy(), known.iterations
         if known.tips is not None or limit <= known.iterations:
             raise SolverBudgetExceeded(f"the model run takes over {limit:g} solver iterations, its budget")
     model = _model(params, effects, recording, resolution)
     try:
-        tips = model.run(recording.tendon_mm - zero_offsets_mm, recording.insertion_mm, recording.sample_period_s,
-                         limit)
+        tips, tension = model.run_with_tension(recording.tendon_mm - zero_offsets_mm, recording.insertion_mm,
+                                               recording.sample_period_s, limit)
     except SolverBudgetExceeded:
-        _remember(key, _Outcome(None, limit, False))
+        _remember(key, _Outcome(None, None, limit, False))
         raise
     except ModelSolverError:
-        _remember(key, _Outcome(None, 0, True))
+        _remember(key, _Outcome(None, None, 0, True))
         raise
-    _remember(key, _Outcome(tips.copy(), model.solver_iterations[0], False))
-    return tips, model.solver_iterations[0]
+    _remember(key, _Outcome(tips.copy(), tension.copy(), model.solver_iterations[0], False))
+    return tips, tension, model.solver_iterations[0]
 
 
 RUN_MEMORY = 96   # runs remembered per process: a Jacobian and its point take 1 + n runs per recording
@@ -203,9 +208,11 @@ RUN_MEMORY = 96   # runs remembered per process: a Jacobian and its point take 1
 
 @dataclass(frozen=True)
 class _Outcome:
-    """A remembered run: its tips and Newton iterations; or no tips, over a budget of `iterations`; or diverged."""
+    """A remembered run: its tips, drive tensions and Newton iterations; or no tips, over a budget of
+    `iterations`; or diverged."""
 
     tips: np.ndarray | None
+    tension: np.ndarray | None
     iterations: float
     diverged: bool
 
@@ -218,20 +225,6 @@ def _remember(key: tuple, outcome: _Outcome) -> None:
     _RUNS.move_to_end(key)
     while len(_RUNS) > RUN_MEMORY:
         _RUNS.popitem(last=False)
-
-
-def predict_tips_and_tension(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarray,
-                             recording: Recording, resolution: Resolution) -> tuple[np.ndarray, np.ndarray]:
-    """Model tips [T, 3] (mm) and drive tensions [T, 4] (N), stepping sample by sample (slower)."""
-    model = _model(params, effects, recording, resolution)
-    u = recording.tendon_mm - zero_offsets_mm
-    dt_s = recording.sample_period_s
-    tips = np.empty((len(recording), 3))
-    tension = np.empty((len(recording), 4))
-    for t in range(len(recording)):
-        tips[t] = model.run(u[t:t + 1], recording.insertion_mm[t:t + 1], dt_s)[0]
-        tension[t] = model.drive_tension_n
-    return tips, tension
 
 
 def _model(params: CatheterParams, effects: EffectTerms, recording: Recording,

@@ -9,7 +9,7 @@ import pytest
 from model import CatheterParams, SolverBudgetExceeded
 from model.gap.calibration import ModelFit, tip_errors
 from model.gap.recording import Recording
-from model.gap.simulation import Resolution, catheter_for, predict_tips_and_work
+from model.gap.simulation import Resolution, catheter_for, predict_run
 
 RESOLUTION = Resolution(n_elements=6)
 
@@ -27,7 +27,7 @@ def bending_recording(name: str, turns: float) -> Recording:
 def case():
     recordings = [bending_recording("first", 1.0), bending_recording("second", 1.5)]
     fit = ModelFit(catheter_for(CatheterParams.from_toml(), recordings), (0.0, 0.0, 0.0, 0.0), {})
-    work = [predict_tips_and_work(fit.params, fit.terms(), np.zeros(4), r, RESOLUTION)[1] for r in recordings]
+    work = [predict_run(fit.params, fit.terms(), np.zeros(4), r, RESOLUTION)[2] for r in recordings]
     return recordings, fit, work
 
 
@@ -44,9 +44,9 @@ def test_the_limit_bounds_the_runs_along_all_recordings_together(case):
 
 def test_a_remembered_run_obeys_the_limit_asked_for(case):
     recordings, fit, (first, _) = case
-    tips, work = predict_tips_and_work(fit.params, fit.terms(), np.zeros(4), recordings[0], RESOLUTION)
+    tips, _, work = predict_run(fit.params, fit.terms(), np.zeros(4), recordings[0], RESOLUTION)
     assert work == first
     with pytest.raises(SolverBudgetExceeded):
-        predict_tips_and_work(fit.params, fit.terms(), np.zeros(4), recordings[0], RESOLUTION, first - 1)
-    again, work_again = predict_tips_and_work(fit.params, fit.terms(), np.zeros(4), recordings[0], RESOLUTION, first)
+        predict_run(fit.params, fit.terms(), np.zeros(4), recordings[0], RESOLUTION, first - 1)
+    again, _, work_again = predict_run(fit.params, fit.terms(), np.zeros(4), recordings[0], RESOLUTION, first)
     assert work_again == first and np.array_equal(again, tips)
