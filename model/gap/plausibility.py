@@ -7,7 +7,14 @@ Two checks, each giving a reason when it fails (a fit that passes both has no re
    than the effect can be, i.e. it absorbs something else. Lumen compression acts near the base:
    its extent may reach NEAR_BASE_FRACTION of the catheter's flexible length, no further (a
    compression along the whole catheter is a different moment arm or stiffness, i.e. model form:
-   on the rod plant without effects a fit with extent 181 mm took 48 % of the residual). A
+   on the rod plant without effects a fit with extent 181 mm took 48 % of the residual). Nor may
+   it be shorter than MIN_EXTENT_ELEMENTS of an element of the fits' model (flexible length over
+   its elements): the moment arm shrinks as exp(-s/extent) from the base, and the first element's
+   middle lies half an element out, so a shorter extent reaches that element alone. Its two
+   parameters then act as one, a softer base element, which is not the compression the effect
+   describes: on the rod plant, a stiffness step (out of catalog) was named lumen_compression with
+   extents of 3.5-4.2 mm on three seeds at 12.5 mm elements, while every lumen compression the
+   Dahl family's seeds named had 15-34 mm. A
    rate lag must be resolvable at the fits' sampling: its time constant at least
    MIN_LAG_SAMPLES of a (decimated) sample period. A lag shorter than that moves each sample by
    less than it moves between samples; with tau -> 0 the creep s + tau ds/dt = c T is the
@@ -50,6 +57,7 @@ ZERO_LOAD_DEG = 15.0
 HIGH_ARTICULATION_DEG = 45.0
 FAST_MM_S = 2.0
 NEAR_BASE_FRACTION = 0.5
+MIN_EXTENT_ELEMENTS = 0.5
 MIN_LAG_SAMPLES = 0.5
 EVERY_REGION = "every region"
 
@@ -75,10 +83,10 @@ def _region_masks(f: SampleFeatures) -> dict:
 
 
 def range_reasons(effect_id: str, values: tuple[float, ...], flexible_length_mm: float | None = None,
-                  sample_period_s: float | None = None) -> list[str]:
+                  sample_period_s: float | None = None, element_length_mm: float | None = None) -> list[str]:
     """Why the effect's fitted values are implausible (empty: plausible); flexible_length_mm: the
-    catheter's, and sample_period_s: the fits' sample period, for the effects whose range depends on
-    them (None: not checked)."""
+    catheter's, sample_period_s: the fits' sample period, and element_length_mm: the length of an
+    element of the fits' model, for the effects whose range depends on them (None: not checked)."""
     candidate = effect(effect_id)
     reasons = []
     if effect_id == "rate_lag" and sample_period_s is not None and values[1] < MIN_LAG_SAMPLES * sample_period_s:
@@ -89,6 +97,11 @@ def range_reasons(effect_id: str, values: tuple[float, ...], flexible_length_mm:
             and values[1] > NEAR_BASE_FRACTION * flexible_length_mm:
         reasons.append(f"lumen_compression.extent_mm = {values[1]:.4g} reaches beyond {NEAR_BASE_FRACTION:g} of the "
                        f"flexible length ({flexible_length_mm:g} mm): a compression near the base does not")
+    if effect_id == "lumen_compression" and element_length_mm is not None \
+            and values[1] < MIN_EXTENT_ELEMENTS * element_length_mm:
+        reasons.append(f"lumen_compression.extent_mm = {values[1]:.3g} is shorter than {MIN_EXTENT_ELEMENTS:g} of an "
+                       f"element of the fits' model ({element_length_mm:.3g} mm): it reaches the first element "
+                       "alone, a softer base with one freedom more, not a compression along the base")
     for name, value, low, high in zip(candidate.param_names, values, candidate.lower, candidate.upper):
         if not low <= value <= high:
             reasons.append(f"{effect_id}.{name} = {value:.4g} is outside its physical range [{low:g}, {high:g}]")

@@ -2,8 +2,11 @@
 whose improvement does not sit where its signature says, is rejected with a reason."""
 import numpy as np
 
+from model import CatheterParams, DahlCatheter
+from model.effects import combined_terms
 from model.gap.plausibility import MIN_SIGNATURE_CONCENTRATION, range_reasons, signature_reasons
 from model.gap.sample_features import SampleFeatures
+from tests.model.conftest import articulation
 
 
 def features(articulation_deg):
@@ -69,3 +72,35 @@ def test_lumen_compression_along_the_whole_catheter_is_not_near_the_base():
     assert range_reasons("lumen_compression", (0.03, 20.0), flexible_length_mm=100.0) == []
     reasons = range_reasons("lumen_compression", (0.01, 181.0), flexible_length_mm=100.0)
     assert len(reasons) == 1 and "flexible length" in reasons[0]
+
+
+def test_lumen_compression_shorter_than_half_an_element_is_not_resolved():
+    assert range_reasons("lumen_compression", (0.03, 20.0), element_length_mm=12.5) == []
+    reasons = range_reasons("lumen_compression", (0.08, 3.5), element_length_mm=12.5)
+    assert len(reasons) == 1 and "first element" in reasons[0]
+
+
+def test_a_lumen_compression_within_the_first_element_has_one_freedom_not_two():
+    """The moment arm shrinks by 1 / (1 + c T exp(-s/extent)) at element middles s = (i + 1/2) h. Under
+    half an element, a compression with c exp(-h / (2 extent)) held fixed bends the catheter alike
+    whatever its extent (one freedom), which the plausibility rule relies on; over an element, the
+    same exchange moves the tip (two freedoms)."""
+    params = CatheterParams.from_toml()
+    n_elements = 8
+    h_mm = params.free_length_mm / n_elements
+    u = articulation(params, 150.0, 0.0)
+
+    def tip(coef_per_n, extent_mm):
+        terms = combined_terms({"lumen_compression": (coef_per_n, extent_mm)} if coef_per_n else {})
+        return DahlCatheter(params, n_elements, terms).move_to(u)
+
+    def same_first_element(coef_per_n, extent_mm, other_extent_mm):
+        """The coefficient at other_extent_mm with the first element's arm as at (coef, extent)."""
+        return coef_per_n * np.exp(-0.5 * h_mm / extent_mm) / np.exp(-0.5 * h_mm / other_extent_mm)
+
+    effect_size_mm = np.linalg.norm(tip(0.08, 0.35 * h_mm) - tip(0.0, 1.0))
+    short = np.linalg.norm(tip(0.08, 0.35 * h_mm) - tip(same_first_element(0.08, 0.35 * h_mm, 0.25 * h_mm), 0.25 * h_mm))
+    long = np.linalg.norm(tip(0.03, 2.0 * h_mm) - tip(same_first_element(0.03, 2.0 * h_mm, 3.0 * h_mm), 3.0 * h_mm))
+    assert effect_size_mm > 1.0
+    assert short < 0.1 * effect_size_mm
+    assert long > 10.0 * short
