@@ -165,7 +165,7 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
         reasons += range_reasons(added, result.fit.effects[added], train[0].flexible_length_mm,
                                  1.0 / res.fit_rate_hz, train[0].flexible_length_mm / res.n_elements)
         reasons += signature_reasons(added, chosen_features, np.concatenate(before_errors),
-                                     np.concatenate(split.selected(result.holdout_errors)))[0]
+                                     np.concatenate(split.selected(result.holdout_errors)), noise)[0]
         return reasons
 
     chosen: list[CandidateResult] = []

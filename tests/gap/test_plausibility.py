@@ -66,6 +66,13 @@ def test_a_tracker_offset_need_not_concentrate_at_zero_load_but_must_help_everyw
     worse_at_zero_load[:21] = 0.5 * offset
     reasons, concentration = signature_reasons("tracker_offset", f, before, worse_at_zero_load)
     assert concentration < 0.0 and reasons and "zero load" in reasons[0]
+    # worse at zero load by noise alone (0.3 -> 0.31 of the offset, tracker noise 0.1 mm per axis): found
+    within_noise = after.copy()
+    within_noise[:21] = 0.31 * offset
+    reasons, concentration = signature_reasons("tracker_offset", f, before, within_noise, noise_mm=0.1)
+    assert concentration < 0.0 and reasons == []
+    reasons, _ = signature_reasons("tracker_offset", f, before, worse_at_zero_load, noise_mm=0.1)
+    assert reasons and "zero load" in reasons[0]
 
 
 def test_lumen_compression_along_the_whole_catheter_is_not_near_the_base():
