@@ -5,7 +5,8 @@ Least squares over the tip error of every valid sample of the training recording
     minimise  sum_t |tip_model(t; p) - tip_measured(t)|^2 + r_scale(p)^2,   p in bounds,
 
 where r_scale is 0 unless the recordings logged drive tensions, and then holds the model tensions'
-scale against the logged ones (`tension_scale`: the one direction the tips leave free), with the model driven by the measured tendon and insertion positions (scipy.optimize.least_squares,
+scale against the logged ones (`tension_scale`: the one direction the tips leave free), with the
+model driven by the measured tendon and insertion positions (scipy.optimize.least_squares,
 trust-region reflective, forward-difference Jacobian), warm-started from the given parameters.
 
 Between good starting parameters the cost has ridges (where a parameter change flips a tendon

@@ -30,11 +30,11 @@ Two checks, each giving a reason when it fails (a fit that passes both has no re
    is present at zero load) does not explain the residual the way its physics would. A region
    with fewer than MIN_REGION_SAMPLES samples cannot tell and passes.
    An effect whose signature is everywhere (EVERY_REGION: a constant bias) must not make any
-   region worse by more than noise explains (`worse_regions`), but need not concentrate in any: the baseline's tendon zeros
-   absorb part of a constant tip offset at zero load (a slight bend under a little pretension)
-   and none of it where the catheter is bent, so a true offset's gain lies mostly at high
-   articulation (0.09-0.36 of its share at zero load on three logs with a true offset, which
-   the zero-load rule rejected). A fit that makes any region worse, by more than noise and
+   region worse by more than noise explains (`worse_regions`), but need not concentrate in any:
+   the baseline's tendon zeros absorb part of a constant tip offset at zero load (a slight bend
+   under a little pretension) and none of it where the catheter is bent, so a true offset's gain
+   lies mostly at high articulation (0.09-0.36 of its share at zero load on three logs with a
+   true offset, which the zero-load rule rejected). A fit that makes any region worse, by more than noise and
    fitting freedom explain, absorbs something else.
 
 The signature regions (the catalog's `signature_region`):

@@ -106,7 +106,9 @@ def test_a_lumen_compression_within_the_first_element_has_one_freedom_not_two():
         return coef_per_n * np.exp(-0.5 * h_mm / extent_mm) / np.exp(-0.5 * h_mm / other_extent_mm)
 
     effect_size_mm = np.linalg.norm(tip(0.08, 0.35 * h_mm) - tip(0.0, 1.0))
-    short = np.linalg.norm(tip(0.08, 0.35 * h_mm) - tip(same_first_element(0.08, 0.35 * h_mm, 0.25 * h_mm), 0.25 * h_mm))
+    short_extent_mm, shorter_mm = 0.35 * h_mm, 0.25 * h_mm
+    short = np.linalg.norm(tip(0.08, short_extent_mm)
+                           - tip(same_first_element(0.08, short_extent_mm, shorter_mm), shorter_mm))
     long = np.linalg.norm(tip(0.03, 2.0 * h_mm) - tip(same_first_element(0.03, 2.0 * h_mm, 3.0 * h_mm), 3.0 * h_mm))
     assert effect_size_mm > 1.0
     assert short < 0.1 * effect_size_mm
