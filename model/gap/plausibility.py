@@ -50,6 +50,7 @@ from __future__ import annotations
 import numpy as np
 
 from model.effects.catalog import effect
+from model.gap.calibration import rmse_mm
 from model.gap.sample_features import SampleFeatures
 from model.gap.significance import is_meaningful
 
@@ -163,16 +164,16 @@ def worse_regions(features: SampleFeatures, before_mm: np.ndarray, after_mm: np.
     """The regions (with MIN_REGION_SAMPLES or more) whose RMSE the fit raised by more than noise and
     fitting freedom explain: going back from after to before there would be a found gain
     (`significance.is_meaningful`); (name, before, after) each, worst first. A true tracker offset
-    leaves the zero-load region as it was (the baseline's tendon zeros had taken up the offset there):
-    one in family, fitted within 0.04 mm of the truth, raised it by noise alone (C_R -0.15), and a
-    rule without that tolerance rejected it."""
+    can leave the zero-load region a little worse (the baseline's tendon zeros had taken up the
+    offset there): on dahl seed 49 one did so by noise alone (C_R -0.04) and a rule without that
+    tolerance rejected it; on dahl seed 55 one, fitted within 0.04 mm of the truth, raised it from
+    0.274 to 0.320 mm, beyond noise, and is still rejected."""
     worse = []
     for name in _region_masks(features):
         region = signature_region(name, features)
         if region.sum() < MIN_REGION_SAMPLES:
             continue
-        before_rmse = float(np.sqrt(np.mean(np.sum(np.asarray(before_mm)[region] ** 2, axis=1))))
-        after_rmse = float(np.sqrt(np.mean(np.sum(np.asarray(after_mm)[region] ** 2, axis=1))))
+        before_rmse, after_rmse = rmse_mm([np.asarray(before_mm)[region]]), rmse_mm([np.asarray(after_mm)[region]])
         if after_rmse > before_rmse and is_meaningful(after_rmse, before_rmse, noise_mm):
             worse.append((name, before_rmse, after_rmse))
     return sorted(worse, key=lambda row: row[1] / row[2])
