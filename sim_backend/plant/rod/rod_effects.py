@@ -1,8 +1,9 @@
 """The rod plant's effects, in its own physical terms, and the ranges a benchmark draws them from.
 
-The ids are the effect catalog's (so a diagnosis can be scored against them) plus three that
-exist only in this plant (sheath_creep, lumen_offset_drift, stiffness_step). The physics and
-the parameter names are this plant's own; rod_plant.py and step_solver.py implement them.
+The ids are the effect catalog's (so a diagnosis can be scored against them) plus four that
+exist only in this plant (sheath_creep, sheath_compression, lumen_offset_drift, stiffness_step).
+The physics and the parameter names are this plant's own; rod_plant.py and step_solver.py
+implement them.
 
 Each parameter has an allowed interval (validation) and a drawing range (low, typical, high):
 draw = "log": log-uniform in [low, high]; "log_signed": magnitude log-uniform in [low, high],
@@ -50,10 +51,12 @@ ROD_EFFECTS: dict[str, RodEffect] = {e.id: e for e in (
               "the drum follows the motor only once the motor crosses the play",
               {"gear_play_mm": _p(0.4, 0.1, 2.0, "log", (0.0, 5.0))}),
     RodEffect("lumen_compression",
-              "a soft proximal sheath section of length soft_length_mm with axial stiffness "
-              "soft_axial_stiffness_n: the summed tendon tension compresses it and takes up pull",
-              {"soft_length_mm": _p(20.0, 5.0, 60.0, "log", (0.1, 500.0)),
-               "soft_axial_stiffness_n": _p(1000.0, 300.0, 5000.0, "log", (10.0, 1e7))}),
+              "the lumens' wall yields under load over the proximal soft_wall_length_mm (the seed "
+              "paper's Fig. 3.1: lumens displaced by high loading, less curvature near the base): each "
+              "tendon's own tension T pushes its lumen toward the neutral axis, moment arm "
+              "r^2 / (r + radial_compliance_mm_per_n T)",
+              {"radial_compliance_mm_per_n": _p(0.04, 0.005, 0.1, "log", (0.0, 10.0)),
+               "soft_wall_length_mm": _p(20.0, 5.0, 40.0, "log", (0.1, 500.0))}),
     RodEffect("tube_friction",
               "Coulomb friction of the catheter in its support tube, driven through a compliant "
               "proximal shaft: the free length moves only once the shaft force exceeds the grip, "
@@ -91,6 +94,12 @@ ROD_EFFECTS: dict[str, RodEffect] = {e.id: e for e in (
               "the bend with time_constant_s, so a sustained bend slowly deepens (long-term EI*(1-f))",
               {"creep_fraction": _p(0.15, 0.03, 0.3, "log", (0.0, 0.9)),
                "time_constant_s": _p(5.0, 1.0, 60.0, "log", (0.01, 1e5))}, in_catalog=False),
+    RodEffect("sheath_compression",
+              "a soft proximal sheath section of length soft_length_mm with axial stiffness "
+              "soft_axial_stiffness_n: the summed tendon tension compresses it and takes up every "
+              "tendon's pull alike",
+              {"soft_length_mm": _p(20.0, 5.0, 60.0, "log", (0.1, 500.0)),
+               "soft_axial_stiffness_n": _p(1000.0, 300.0, 5000.0, "log", (10.0, 1e7))}, in_catalog=False),
     RodEffect("lumen_offset_drift",
               "the lumens' radius drifts linearly along the free length, by tip_offset_change_mm at "
               "the tip relative to the tube exit",

@@ -133,7 +133,7 @@ class RodPlant:
             if tau_over_dt > 0.0:     # Kelvin-Voigt by backward Euler (module doc, step 3)
                 ei = nodes["ei"] * (1.0 + tau_over_dt)
                 rest = (kappa_rest + tau_over_dt * self.kappa_per_mm) / (1.0 + tau_over_dt)
-            iterations = solve_step(nodes["h_mm"], ei, nodes["r"], nodes["cos_phi"], nodes["sin_phi"],
+            iterations = solve_step(nodes["h_mm"], ei, nodes["r"], nodes["give"], nodes["cos_phi"], nodes["sin_phi"],
                                     nodes["ea_axial"], rest, nodes["kappa_set"], nodes["weight"],
                                     self._drive_compliance, self.description.tendon_axial_stiffness_n, mu,
                                     self.description.friction_n_per_mm, target, self.tension_n, drive, tension,
@@ -184,9 +184,13 @@ class RodPlant:
         r = self.description.tendon_offset_mm + fx.get("lumen_offset_drift", {}).get("tip_offset_change_mm", 0.0) * s / length
         helix = fx.get("torsion", {}).get("helix_rad_per_mm", 0.0)
         phi = np.arange(4) * (np.pi / 2) + helix * s[:, None]
-        ea_axial = np.full(m, self.description.axial_stiffness_n)
+        give = np.zeros(m)
         if "lumen_compression" in fx:
-            soft = fx["lumen_compression"]
+            wall = fx["lumen_compression"]
+            give[s <= wall["soft_wall_length_mm"]] = wall["radial_compliance_mm_per_n"]
+        ea_axial = np.full(m, self.description.axial_stiffness_n)
+        if "sheath_compression" in fx:
+            soft = fx["sheath_compression"]
             ea_axial[s <= soft["soft_length_mm"]] = soft["soft_axial_stiffness_n"]
         pre = fx.get("precurvature", {})
         kappa_set = np.tile([pre.get("rest_kappa_x_per_mm", 0.0), pre.get("rest_kappa_y_per_mm", 0.0)], (m, 1))
@@ -198,5 +202,5 @@ class RodPlant:
             lumped[[0, -1]] = 0.5 * h
             weight[:, 0] = g["load_n_per_mm"] * lumped * np.cos(direction)
             weight[:, 1] = g["load_n_per_mm"] * lumped * np.sin(direction)
-        return {"h_mm": h, "ei": ei, "r": r, "cos_phi": np.cos(phi), "sin_phi": np.sin(phi), "ea_axial": ea_axial,
+        return {"h_mm": h, "ei": ei, "r": r, "give": give, "cos_phi": np.cos(phi), "sin_phi": np.sin(phi), "ea_axial": ea_axial,
                 "kappa_set": kappa_set, "weight": weight}

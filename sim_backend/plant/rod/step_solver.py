@@ -6,9 +6,14 @@ Given them, one walk from the base to the tip gives everything else:
 1. Tendon tensions node by node, by the friction return mapping (tendon_friction.py) from the
    previous step's profile T_prev (the memory).
 2. Curvature at each node from the moment balance of the distal part (Kirchhoff rod, tendons
-   routed parallel to the backbone at radius r, angle phi_k(s) in the cross-section):
+   routed parallel to the backbone at moment arm a_k, angle phi_k(s) in the cross-section):
 
-       kappa(s) = kappa_rest(s) + ( sum_k T_k(s) r(s) (-sin phi_k, cos phi_k) + m_w(s) ) / EI(s)
+       kappa(s) = kappa_rest(s) + ( sum_k T_k(s) a_k(s) (-sin phi_k, cos phi_k) + m_w(s) ) / EI(s)
+
+   The arm is the lumen radius r(s), less what the tendon's own load pushes its lumen toward the
+   neutral axis where the lumen wall yields (radial compliance c_r(s), mm/N; lumen_compression):
+
+       a_k = r^2 / (r + c_r T_k),   so   d(T_k a_k)/dT_k = a_k^2 / r,   d a_k/dT_k = -c_r a_k^2 / r^2
 
    m_w: the moment of the rod's own weight (backbone.weight_moments_body), from the latest shape.
 3. The backbone, segment by segment as exact arcs (backbone.py), with axial strain
@@ -20,15 +25,18 @@ bend (relative to the shape at which the tendons were zeroed, kappa_set) and by 
 compression:
 
     g_k = c_d T_k(0) + int_0^L [ delta_k + T_k / EA_t - eps ] ds - u_k = 0,
-    delta_k(s) = r(s) * ( (ky - ky_set) cos phi_k - (kx - kx_set) sin phi_k )
+    delta_k(s) = a_k(s) * ( (ky - ky_set) cos phi_k - (kx - kx_set) sin phi_k )
 
 A tendon cannot push: T_k(0) >= 0, and a tendon whose g_k >= 0 at zero tension is slack.
 Solved by projected Newton on T(0) with the Jacobian of the walk (tensions' sensitivities
 S_j(s) = dT_j(s)/dT_j(0), zero where the tendon sticks):
 
-    dg_k/dT_j(0) = c_d [k=j] + int S_j(s) [ r^2 cos(phi_k - phi_j) / EI + 1/EA_axial + [k=j]/EA_t ] ds
+    dg_k/dT_j(0) = c_d [k=j] + int S_j(s) [ a_k a_j^2 / r cos(phi_k - phi_j) / EI + 1/EA_axial
+                                            + [k=j] (1/EA_t + (d a_k/dT_k) delta_k / a_k) ] ds
 
-The weight moment is refreshed from the latest shape at each iteration, so the Newton loop is
+The sensitivities S_j neglect how T_j's pull changes the other tendons' wraps (through the curvature),
+so this Jacobian is approximate (columns off by up to a quarter on a bent rod); the backtracking
+below makes up for it. The weight moment is refreshed from the latest shape at each iteration, so the Newton loop is
 also the fixed point of the weight's moment. Integrals use the trapezoid rule on the nodes.
 """
 from __future__ import annotations
@@ -45,20 +53,28 @@ BACKTRACKS = 8       # halvings of a Newton step before it is taken whole
 
 
 @njit(cache=True)
-def _curvature(i, tension, r_mm, cos_phi, sin_phi, ei_nmm2, kappa_rest, moment_w, out):
+def _arm(r_mm, give_mm_per_n, tension_n):
+    """Moment arm a = r^2 / (r + c_r T) of a tendon at tension T whose lumen wall yields by c_r per N."""
+    if give_mm_per_n == 0.0:
+        return r_mm
+    return r_mm * r_mm / (r_mm + give_mm_per_n * tension_n)
+
+
+@njit(cache=True)
+def _curvature(i, tension, arm, cos_phi, sin_phi, ei_nmm2, kappa_rest, moment_w, out):
     mx = moment_w[i, 0]
     my = moment_w[i, 1]
     for k in range(4):
-        mx -= tension[i, k] * r_mm[i] * sin_phi[i, k]
-        my += tension[i, k] * r_mm[i] * cos_phi[i, k]
+        mx -= tension[i, k] * arm[i, k] * sin_phi[i, k]
+        my += tension[i, k] * arm[i, k] * cos_phi[i, k]
     out[i, 0] = kappa_rest[i, 0] + mx / ei_nmm2[i]
     out[i, 1] = kappa_rest[i, 1] + my / ei_nmm2[i]
 
 
 @njit(cache=True)
-def _walk(drive_n, h_mm, ei_nmm2, r_mm, cos_phi, sin_phi, ea_axial_n, kappa_rest, kappa_set, moment_w,
-          c_drive_mm_per_n, ea_tendon_n, mu, c0_n_per_mm, pull_mm, tension_prev,
-          tension, sens, kappa, rotation, position, residual, jacobian):
+def _walk(drive_n, h_mm, ei_nmm2, r_mm, give_mm_per_n, cos_phi, sin_phi, ea_axial_n, kappa_rest, kappa_set,
+          moment_w, c_drive_mm_per_n, ea_tendon_n, mu, c0_n_per_mm, pull_mm, tension_prev,
+          tension, sens, arm, kappa, rotation, position, residual, jacobian):
     """Tensions, curvature and backbone for drive tensions `drive_n`; fills residual g and its Jacobian."""
     m = tension.shape[0]
     q = np.empty((3, 3))
@@ -66,7 +82,8 @@ def _walk(drive_n, h_mm, ei_nmm2, r_mm, cos_phi, sin_phi, ea_axial_n, kappa_rest
     for k in range(4):
         tension[0, k] = drive_n[k]
         sens[0, k] = 1.0
-    _curvature(0, tension, r_mm, cos_phi, sin_phi, ei_nmm2, kappa_rest, moment_w, kappa)
+        arm[0, k] = _arm(r_mm[0], give_mm_per_n[0], drive_n[k])
+    _curvature(0, tension, arm, cos_phi, sin_phi, ei_nmm2, kappa_rest, moment_w, kappa)
     for a in range(3):
         for b in range(3):
             rotation[0, a, b] = 1.0 if a == b else 0.0
@@ -80,16 +97,20 @@ def _walk(drive_n, h_mm, ei_nmm2, r_mm, cos_phi, sin_phi, ea_axial_n, kappa_rest
             bend = math.hypot(kx, ky)
             wrap = bend * h_mm
             for k in range(4):
-                # d wrap / d T_k: the tendon's own moment arm along the bend direction, over EI
+                # d wrap / d T_k: d(T_k a_k)/dT_k along the bend direction, over EI (a_k at the
+                # proximal tension: this only steers the sensitivity)
                 wrap_per_n = 0.0
                 if bend > 0.0:
-                    wrap_per_n = h_mm * r_mm[i] * (ky * cos_phi[i, k] - kx * sin_phi[i, k]) / (bend * ei_nmm2[i])
+                    a = _arm(r_mm[i], give_mm_per_n[i], tension[i - 1, k])
+                    wrap_per_n = (h_mm * a * a / r_mm[i] * (ky * cos_phi[i, k] - kx * sin_phi[i, k])
+                                  / (bend * ei_nmm2[i]))
                 tension[i, k], sens[i, k] = clamp_to_capstan(tension_prev[i, k], tension[i - 1, k], sens[i - 1, k],
                                                              mu[k], wrap, wrap_per_n, c0_h)
                 if tension[i, k] < 0.0:
                     tension[i, k] = 0.0
                     sens[i, k] = 0.0
-            _curvature(i, tension, r_mm, cos_phi, sin_phi, ei_nmm2, kappa_rest, moment_w, kappa)
+                arm[i, k] = _arm(r_mm[i], give_mm_per_n[i], tension[i, k])
+            _curvature(i, tension, arm, cos_phi, sin_phi, ei_nmm2, kappa_rest, moment_w, kappa)
             kx = 0.5 * (kappa[i - 1, 0] + kappa[i, 0])
             ky = 0.5 * (kappa[i - 1, 1] + kappa[i, 1])
         sum_prev = tension[i - 1, 0] + tension[i - 1, 1] + tension[i - 1, 2] + tension[i - 1, 3]
@@ -117,20 +138,21 @@ def _walk(drive_n, h_mm, ei_nmm2, r_mm, cos_phi, sin_phi, ea_axial_n, kappa_rest
         for k in range(4):
             ck = cos_phi[i, k]
             sk = sin_phi[i, k]
-            residual[k] += w * (r_mm[i] * (dky * ck - dkx * sk) + tension[i, k] / ea_tendon_n
-                                + total / ea_axial_n[i])
+            shortening = dky * ck - dkx * sk
+            residual[k] += w * (arm[i, k] * shortening + tension[i, k] / ea_tendon_n + total / ea_axial_n[i])
             for j in range(4):
                 if sens[i, j] == 0.0:
                     continue
                 # cos(phi_k - phi_j) = cos phi_k cos phi_j + sin phi_k sin phi_j
-                g = r_mm[i] * r_mm[i] * (ck * cos_phi[i, j] + sk * sin_phi[i, j]) / ei_nmm2[i] + 1.0 / ea_axial_n[i]
+                g = (arm[i, k] * arm[i, j] * arm[i, j] / r_mm[i] * (ck * cos_phi[i, j] + sk * sin_phi[i, j])
+                     / ei_nmm2[i] + 1.0 / ea_axial_n[i])
                 if k == j:
-                    g += 1.0 / ea_tendon_n
+                    g += 1.0 / ea_tendon_n - give_mm_per_n[i] * arm[i, k] * arm[i, k] / (r_mm[i] * r_mm[i]) * shortening
                 jacobian[k, j] += w * sens[i, j] * g
 
 
 @njit(cache=True)
-def solve_step(h_mm, ei_nmm2, r_mm, cos_phi, sin_phi, ea_axial_n, kappa_rest, kappa_set, weight_n,
+def solve_step(h_mm, ei_nmm2, r_mm, give_mm_per_n, cos_phi, sin_phi, ea_axial_n, kappa_rest, kappa_set, weight_n,
                c_drive_mm_per_n, ea_tendon_n, mu, c0_n_per_mm, pull_mm, tension_prev, drive_n,
                tension, kappa, rotation, position, tol_mm, max_iterations):
     """Projected Newton on the drive tensions `drive_n` (in: the guess, out: the solution).
@@ -144,6 +166,7 @@ def solve_step(h_mm, ei_nmm2, r_mm, cos_phi, sin_phi, ea_axial_n, kappa_rest, ka
     """
     m = tension.shape[0]
     sens = np.empty((m, 4))
+    arm = np.empty((m, 4))
     moment_w = np.zeros((m, 2))
     residual = np.empty(4)
     jacobian = np.empty((4, 4))
@@ -154,9 +177,9 @@ def solve_step(h_mm, ei_nmm2, r_mm, cos_phi, sin_phi, ea_axial_n, kappa_rest, ka
     last_tip = np.full(3, np.inf)
     if has_weight:
         weight_moments_body(position, rotation, weight_n, moment_w)
-    _walk(drive_n, h_mm, ei_nmm2, r_mm, cos_phi, sin_phi, ea_axial_n, kappa_rest, kappa_set, moment_w,
-          c_drive_mm_per_n, ea_tendon_n, mu, c0_n_per_mm, pull_mm, tension_prev,
-          tension, sens, kappa, rotation, position, residual, jacobian)
+    _walk(drive_n, h_mm, ei_nmm2, r_mm, give_mm_per_n, cos_phi, sin_phi, ea_axial_n, kappa_rest, kappa_set,
+          moment_w, c_drive_mm_per_n, ea_tendon_n, mu, c0_n_per_mm, pull_mm, tension_prev,
+          tension, sens, arm, kappa, rotation, position, residual, jacobian)
     for iteration in range(max_iterations):
         # a tendon at zero tension that would need to push is slack: hold it at zero
         held = np.zeros(4, dtype=np.bool_)
@@ -187,9 +210,9 @@ def solve_step(h_mm, ei_nmm2, r_mm, cos_phi, sin_phi, ea_axial_n, kappa_rest, ka
                 scale = 1.0
             for k in range(4):
                 trial_drive[k] = max(drive_n[k] + scale * step[k], 0.0)
-            _walk(trial_drive, h_mm, ei_nmm2, r_mm, cos_phi, sin_phi, ea_axial_n, kappa_rest, kappa_set, moment_w,
-                  c_drive_mm_per_n, ea_tendon_n, mu, c0_n_per_mm, pull_mm, tension_prev,
-                  tension, sens, kappa, rotation, position, trial_residual, trial_jacobian)
+            _walk(trial_drive, h_mm, ei_nmm2, r_mm, give_mm_per_n, cos_phi, sin_phi, ea_axial_n, kappa_rest,
+                  kappa_set, moment_w, c_drive_mm_per_n, ea_tendon_n, mu, c0_n_per_mm, pull_mm, tension_prev,
+                  tension, sens, arm, kappa, rotation, position, trial_residual, trial_jacobian)
             trial_held = np.zeros(4, dtype=np.bool_)
             for k in range(4):
                 trial_held[k] = trial_drive[k] <= 0.0 and trial_residual[k] >= 0.0

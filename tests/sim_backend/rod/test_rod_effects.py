@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rod_scenarios import DT_S, description
+from rod_scenarios import DT_S, description, pull
 from sim_backend.plant.rod import ROD_EFFECTS, RodPlant
 
 
@@ -35,8 +35,8 @@ def test_each_effect_at_its_typical_value_moves_the_tip(effect_id, clean_tips):
 
 
 def test_the_out_of_catalog_effects_are_there():
-    assert {e.id for e in ROD_EFFECTS.values() if not e.in_catalog} == {"sheath_creep", "lumen_offset_drift",
-                                                                        "stiffness_step"}
+    assert {e.id for e in ROD_EFFECTS.values() if not e.in_catalog} == {"sheath_creep", "sheath_compression",
+                                                                        "lumen_offset_drift", "stiffness_step"}
 
 
 def test_creep_keeps_bending_during_a_hold():
@@ -56,3 +56,24 @@ def test_the_tracker_sensor_offset_turns_with_the_tip():
         tip, _ = plain.step(DT_S, [u, 0.0, -u, 0.0], 80.0)
         sensor, _ = mounted.step(DT_S, [u, 0.0, -u, 0.0], 80.0)
     assert np.allclose(sensor - tip, 2.0 * plain.rotation[-1][:, 2], atol=1e-9)
+
+
+def test_lumen_compression_takes_the_arm_the_tendon_load_pushes_in_and_straightens_the_base():
+    """Within the soft wall the moment arm is r^2 / (r + c_r T) (the tension's own load pushes the
+    lumen in): the base curvature is sum_k T_k a_k / EI, below the plain rod's, and the more so the
+    harder the pull; under displacement control the lost bend reappears distally."""
+    wall = {"radial_compliance_mm_per_n": 0.04, "soft_wall_length_mm": 20.0}
+    plain, soft = RodPlant(description()), RodPlant(description(effects={"lumen_compression": wall}))
+    r_mm, ei_nmm2 = soft.description.tendon_offset_mm, soft.description.bending_stiffness_nmm2
+    base_ratio = []
+    for start_mm, stop_mm in ((0.0, 2.5), (2.5, 5.0)):
+        for u in np.linspace(start_mm, stop_mm, 50):
+            pull(plain, u)
+            pull(soft, u)
+        arm_mm = r_mm ** 2 / (r_mm + wall["radial_compliance_mm_per_n"] * soft.tension_n[0])
+        moment = soft.tension_n[0] * arm_mm
+        assert np.hypot(*soft.kappa_per_mm[0]) == pytest.approx(abs(moment[0] - moment[2]) / ei_nmm2, rel=1e-9)
+        base_ratio.append(np.hypot(*soft.kappa_per_mm[0]) / np.hypot(*plain.kappa_per_mm[0]))
+    assert base_ratio[1] < base_ratio[0] < 1.0
+    assert np.hypot(*soft.kappa_per_mm[-1]) > np.hypot(*plain.kappa_per_mm[-1])
+
