@@ -61,6 +61,14 @@ def _arm(r_mm, give_mm_per_n, tension_n):
 
 
 @njit(cache=True)
+def _moment_slope(r_mm, give_mm_per_n, arm_mm):
+    """d(T a)/dT = a^2 / r, the moment arm a tendon's own extra tension acts through (r without give)."""
+    if give_mm_per_n == 0.0:
+        return r_mm
+    return arm_mm * arm_mm / r_mm
+
+
+@njit(cache=True)
 def _curvature(i, tension, arm, cos_phi, sin_phi, ei_nmm2, kappa_rest, moment_w, out):
     mx = moment_w[i, 0]
     my = moment_w[i, 1]
@@ -101,9 +109,8 @@ def _walk(drive_n, h_mm, ei_nmm2, r_mm, give_mm_per_n, cos_phi, sin_phi, ea_axia
                 # proximal tension: this only steers the sensitivity)
                 wrap_per_n = 0.0
                 if bend > 0.0:
-                    a = _arm(r_mm[i], give_mm_per_n[i], tension[i - 1, k])
-                    wrap_per_n = (h_mm * a * a / r_mm[i] * (ky * cos_phi[i, k] - kx * sin_phi[i, k])
-                                  / (bend * ei_nmm2[i]))
+                    slope = _moment_slope(r_mm[i], give_mm_per_n[i], _arm(r_mm[i], give_mm_per_n[i], tension[i - 1, k]))
+                    wrap_per_n = h_mm * slope * (ky * cos_phi[i, k] - kx * sin_phi[i, k]) / (bend * ei_nmm2[i])
                 tension[i, k], sens[i, k] = clamp_to_capstan(tension_prev[i, k], tension[i - 1, k], sens[i - 1, k],
                                                              mu[k], wrap, wrap_per_n, c0_h)
                 if tension[i, k] < 0.0:
@@ -144,8 +151,8 @@ def _walk(drive_n, h_mm, ei_nmm2, r_mm, give_mm_per_n, cos_phi, sin_phi, ea_axia
                 if sens[i, j] == 0.0:
                     continue
                 # cos(phi_k - phi_j) = cos phi_k cos phi_j + sin phi_k sin phi_j
-                g = (arm[i, k] * arm[i, j] * arm[i, j] / r_mm[i] * (ck * cos_phi[i, j] + sk * sin_phi[i, j])
-                     / ei_nmm2[i] + 1.0 / ea_axial_n[i])
+                slope = _moment_slope(r_mm[i], give_mm_per_n[i], arm[i, j])
+                g = arm[i, k] * slope * (ck * cos_phi[i, j] + sk * sin_phi[i, j]) / ei_nmm2[i] + 1.0 / ea_axial_n[i]
                 if k == j:
                     g += 1.0 / ea_tendon_n - give_mm_per_n[i] * arm[i, k] * arm[i, k] / (r_mm[i] * r_mm[i]) * shortening
                 jacobian[k, j] += w * sens[i, j] * g
