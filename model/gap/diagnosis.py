@@ -35,7 +35,7 @@ from model.gap.fit_pool import fit_pool, one_blas_thread
 from model.gap.free_parameters import base_values
 from model.gap.holdout_split import HoldoutSplit, split_holdout
 from model.gap.noise import tracker_noise_mm
-from model.gap.plausibility import range_reasons, signature_concentration, signature_reasons
+from model.gap.plausibility import hold_drift_reasons, range_reasons, signature_concentration, signature_reasons
 from model.gap.recording import Recording, RecordingError
 from model.gap.regions import breakdown, concentrated, regions, shrink_by_region
 from model.gap.sample_features import SampleFeatures, compute_features
@@ -148,10 +148,12 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
         sample; be meaningful (selection half) against the baseline (`before`: the single it adds a
         second effect to) and against its own ablation, the same fit with the effect switched off (the
         effect, not the refit of the base parameters that came with it, removes the error); and be
-        plausible: its parameters inside their physical range, its gain where its signature says."""
+        plausible: its parameters inside their physical range, its gain where its signature says, and
+        no tip motion during static holds that the measured tip does not show."""
         if result.failed:
             return ["its held-out prediction failed (the model diverged or was given up): never a verdict"]
-        before_errors = split.selected(before.holdout_errors if before else base_errors)
+        before_all = before.holdout_errors if before else base_errors
+        before_errors = split.selected(before_all)
         before_rmse = rmse_mm(before_errors)
         reasons = []
         if not is_meaningful(before_rmse, result.holdout_rmse_mm, noise):
@@ -166,6 +168,8 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
                                  1.0 / res.fit_rate_hz, train[0].flexible_length_mm / res.n_elements)
         reasons += signature_reasons(added, chosen_features, np.concatenate(before_errors),
                                      np.concatenate(split.selected(result.holdout_errors)), noise)[0]
+        reasons += hold_drift_reasons(added, features, split.selection_mask, np.concatenate(before_all),
+                                      np.concatenate(result.holdout_errors), noise)
         return reasons
 
     chosen: list[CandidateResult] = []

@@ -36,6 +36,18 @@ Two checks, each giving a reason when it fails (a fit that passes both has no re
    lies mostly at high articulation (0.09-0.36 of its share at zero load on three logs with a
    true offset, which the zero-load rule rejected). A fit that makes any region worse, by more than noise and
    fitting freedom explain, absorbs something else.
+3. Holds: over each static hold H (a run of at least MIN_HOLD_SAMPLES consecutive "static" samples
+   of one recording, all in the selection half) the error's drift d_H = e_last - e_first is the
+   model's motion during the hold less the tip's. Its RMS over the holds,
+
+       D = sqrt( mean_H |d_H|^2 ),
+
+   must not grow from before to after by more than noise and fitting freedom explain (the
+   significance test with sqrt(2) sigma per axis, a drift being the difference of two samples),
+   once there are MIN_HOLDS holds. A fit that has the tip creep during holds where the measured tip
+   stands still claims dynamics the data do not show: on the rod plant, which has no drive-line
+   creep, `rate_lag` (lag times of 0.9-4 s, a few micrometres per newton) was its most frequent
+   false verdict, on clean, out-of-catalog and other single-effect cases.
 
 The signature regions (the catalog's `signature_region`):
     zero load          articulation < ZERO_LOAD_DEG
@@ -62,6 +74,8 @@ FAST_MM_S = 2.0
 NEAR_BASE_FRACTION = 0.5
 MIN_EXTENT_ELEMENTS = 0.5
 MIN_LAG_SAMPLES = 0.5
+MIN_HOLD_SAMPLES = 3
+MIN_HOLDS = 3
 EVERY_REGION = "every region"
 
 
@@ -177,3 +191,32 @@ def worse_regions(features: SampleFeatures, before_mm: np.ndarray, after_mm: np.
         if after_rmse > before_rmse and is_meaningful(after_rmse, before_rmse, noise_mm):
             worse.append((name, before_rmse, after_rmse))
     return sorted(worse, key=lambda row: row[1] / row[2])
+
+
+def hold_drift_rms_mm(features: SampleFeatures, selection_mask: np.ndarray,
+                      errors_mm: np.ndarray) -> tuple[float, int]:
+    """(D, number of holds): the RMS over the selection half's static holds of the error's drift
+    e_last - e_first (see module doc, check 3); D is nan without holds."""
+    static = (features.motion == "static") & selection_mask
+    boundaries = np.flatnonzero(np.diff(static.astype(int)) | np.diff(features.recording)) + 1
+    drifts = [errors_mm[run[-1]] - errors_mm[run[0]]
+              for run in np.split(np.arange(len(static)), boundaries)
+              if static[run[0]] and len(run) >= MIN_HOLD_SAMPLES]
+    if not drifts:
+        return float("nan"), 0
+    return float(np.sqrt(np.mean(np.sum(np.square(drifts), axis=1)))), len(drifts)
+
+
+def hold_drift_reasons(effect_id: str, features: SampleFeatures, selection_mask: np.ndarray, before_mm: np.ndarray,
+                       after_mm: np.ndarray, noise_mm: float | None) -> list[str]:
+    """Why the fit moves the tip during static holds more than the measured tip moves (empty: it does
+    not), check 3 of the module doc. features, selection_mask, before_mm and after_mm [n, 3] cover
+    every held-out sample; noise_mm: the tracker noise per axis (None: not checked)."""
+    before, holds = hold_drift_rms_mm(features, selection_mask, np.asarray(before_mm))
+    after, _ = hold_drift_rms_mm(features, selection_mask, np.asarray(after_mm))
+    if noise_mm is None or holds < MIN_HOLDS or not after > before \
+            or not is_meaningful(after, before, np.sqrt(2.0) * noise_mm):
+        return []
+    return [f"{effect_id} moves the tip during static holds where the measured tip stands still: the model's drift "
+            f"against the tip's over {holds} holds grows from {before:.3f} to {after:.3f} mm RMS, more than noise "
+            f"explains"]

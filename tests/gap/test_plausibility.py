@@ -1,10 +1,12 @@
 """Plausibility (issue 14, item 4): a fit that needs parameters at the limit of their physical range, or
 whose improvement does not sit where its signature says, is rejected with a reason."""
 import numpy as np
+import pytest
 
 from model import CatheterParams, DahlCatheter
 from model.effects import combined_terms
-from model.gap.plausibility import MIN_SIGNATURE_CONCENTRATION, range_reasons, signature_reasons
+from model.gap.plausibility import (MIN_SIGNATURE_CONCENTRATION, hold_drift_reasons, hold_drift_rms_mm, range_reasons,
+                                    signature_reasons)
 from model.gap.sample_features import SampleFeatures
 from tests.model.conftest import articulation
 
@@ -113,3 +115,47 @@ def test_a_lumen_compression_within_the_first_element_has_one_freedom_not_two():
     assert effect_size_mm > 1.0
     assert short < 0.1 * effect_size_mm
     assert long > 10.0 * short
+
+
+def hold_features(holds: int, samples_per_hold: int) -> SampleFeatures:
+    """A recording of `holds` static holds, each after a ramp of as many moving samples."""
+    motion = np.array((["loading"] * samples_per_hold + ["static"] * samples_per_hold) * holds)
+    n = len(motion)
+    return SampleFeatures(np.linspace(0.0, 90.0, n), np.zeros(n), np.full(n, 80.0), motion, np.ones(n),
+                          np.linspace(1.0, 5.0, n), np.linspace(0.0, 1.0, n), np.zeros(n, dtype=int))
+
+
+def creep(features: SampleFeatures, per_hold_mm: float) -> np.ndarray:
+    """Errors [n, 3] that grow along x by per_hold_mm over each hold of `hold_features`, from 0 at its start."""
+    errors = np.zeros((len(features.motion), 3))
+    static = features.motion == "static"
+    starts = np.flatnonzero(static & ~np.r_[False, static[:-1]])
+    ends = np.flatnonzero(static & ~np.r_[static[1:], False])
+    for start, end in zip(starts, ends):
+        errors[start:end + 1, 0] = np.linspace(0.0, per_hold_mm, end + 1 - start)
+    return errors
+
+
+def test_a_fit_whose_tip_creeps_in_holds_where_the_tip_stands_still_is_rejected():
+    """The model creeping 0.5 mm per hold against a tip that stands still (noise 0.05 mm) is a drift the
+    data do not show; 0.01 mm of creep is within noise; a fit that removes a measured creep passes."""
+    f = hold_features(holds=6, samples_per_hold=8)
+    everywhere = np.ones(len(f.motion), dtype=bool)
+    still = np.zeros((len(f.motion), 3))
+    reasons = hold_drift_reasons("rate_lag", f, everywhere, still, creep(f, 0.5), noise_mm=0.05)
+    assert len(reasons) == 1 and "static holds" in reasons[0] and "6 holds" in reasons[0]
+    assert hold_drift_reasons("rate_lag", f, everywhere, still, creep(f, 0.01), noise_mm=0.05) == []
+    assert hold_drift_reasons("rate_lag", f, everywhere, creep(f, 0.5), still, noise_mm=0.05) == []
+
+
+def test_hold_drift_is_measured_within_the_selection_half_only():
+    """A hold cut by the selection mask keeps only its selected run; holds outside the selection or
+    shorter than MIN_HOLD_SAMPLES are not counted, and with fewer than MIN_HOLDS nothing is judged."""
+    f = hold_features(holds=6, samples_per_hold=8)
+    errors = creep(f, 0.5)
+    first_half = np.arange(len(f.motion)) < len(f.motion) // 2
+    rms_mm, holds = hold_drift_rms_mm(f, first_half, errors)
+    assert holds == 3 and rms_mm == pytest.approx(0.5)
+    assert hold_drift_rms_mm(f, np.zeros(len(f.motion), dtype=bool), errors)[1] == 0
+    two_holds = np.arange(len(f.motion)) < 4 * 8
+    assert hold_drift_reasons("rate_lag", f, two_holds, np.zeros_like(errors), errors, noise_mm=0.05) == []
