@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from model import CatheterParams, SolverBudgetExceeded
-from model.gap.calibration import ModelFit, tip_errors
+from model.gap.calibration import MIN_ITERATION_LIMIT, ModelFit, tip_errors
+from model.gap.candidates import holdout_iteration_limit
 from model.gap.recording import Recording
 from model.gap.simulation import Resolution, catheter_for, predict_run
 
@@ -50,3 +51,12 @@ def test_a_remembered_run_obeys_the_limit_asked_for(case):
         predict_run(fit.params, fit.terms(), np.zeros(4), recordings[0], RESOLUTION, first - 1)
     again, _, work_again = predict_run(fit.params, fit.terms(), np.zeros(4), recordings[0], RESOLUTION, first)
     assert work_again == first and np.array_equal(again, tips)
+
+
+def test_a_held_out_run_may_take_what_the_start_or_the_fit_itself_took_per_training_sample():
+    """A fit with a compliant drive line takes more Newton iterations per step than its start: its
+    held-out limit follows the larger of the two training limits, scaled by held-out over training samples."""
+    train, holdout = [bending_recording("train", 1.0)], [bending_recording("held", 1.5)]
+    assert holdout_iteration_limit(2000, 6000, train, holdout) == 9000
+    assert holdout_iteration_limit(6000, 2000, train, holdout) == 9000
+    assert holdout_iteration_limit(10, 20, train, holdout) == MIN_ITERATION_LIMIT
