@@ -34,8 +34,8 @@ Two checks, each giving a reason when it fails (a fit that passes both has no re
    the baseline's tendon zeros absorb part of a constant tip offset at zero load (a slight bend
    under a little pretension) and none of it where the catheter is bent, so a true offset's gain
    lies mostly at high articulation (0.09-0.36 of its share at zero load on three logs with a
-   true offset, which the zero-load rule rejected). A fit that makes any region worse, by more than noise and
-   fitting freedom explain, absorbs something else.
+   true offset, which the zero-load rule rejected). A fit that makes any region worse, by more
+   than noise and fitting freedom explain, absorbs something else.
 3. Holds: over each static hold H (a run of at least MIN_HOLD_SAMPLES consecutive "static" samples
    of one recording, all in the selection half) the error's drift d_H = e_last - e_first is the
    model's motion during the hold less the tip's. Its RMS over the holds,

@@ -202,5 +202,5 @@ class RodPlant:
             lumped[[0, -1]] = 0.5 * h
             weight[:, 0] = g["load_n_per_mm"] * lumped * np.cos(direction)
             weight[:, 1] = g["load_n_per_mm"] * lumped * np.sin(direction)
-        return {"h_mm": h, "ei": ei, "r": r, "give": give, "cos_phi": np.cos(phi), "sin_phi": np.sin(phi), "ea_axial": ea_axial,
-                "kappa_set": kappa_set, "weight": weight}
+        return {"h_mm": h, "ei": ei, "r": r, "give": give, "cos_phi": np.cos(phi), "sin_phi": np.sin(phi),
+                "ea_axial": ea_axial, "kappa_set": kappa_set, "weight": weight}

@@ -34,10 +34,11 @@ S_j(s) = dT_j(s)/dT_j(0), zero where the tendon sticks):
     dg_k/dT_j(0) = c_d [k=j] + int S_j(s) [ a_k a_j^2 / r cos(phi_k - phi_j) / EI + 1/EA_axial
                                             + [k=j] (1/EA_t + (d a_k/dT_k) delta_k / a_k) ] ds
 
-The sensitivities S_j neglect how T_j's pull changes the other tendons' wraps (through the curvature),
-so this Jacobian is approximate (columns off by up to a quarter on a bent rod); the backtracking
-below makes up for it. The weight moment is refreshed from the latest shape at each iteration, so the Newton loop is
-also the fixed point of the weight's moment. Integrals use the trapezoid rule on the nodes.
+The sensitivities S_j neglect how T_j's pull changes the other tendons' wraps (through the
+curvature), so this Jacobian is approximate (columns off by up to a quarter on a bent rod); the
+backtracking below makes up for it. The weight moment is refreshed from the latest shape at each
+iteration, so the Newton loop is also the fixed point of the weight's moment. Integrals use the
+trapezoid rule on the nodes.
 """
 from __future__ import annotations
 
@@ -87,6 +88,7 @@ def _walk(drive_n, h_mm, ei_nmm2, r_mm, give_mm_per_n, cos_phi, sin_phi, ea_axia
     m = tension.shape[0]
     q = np.empty((3, 3))
     d = np.empty(3)
+    slope = np.empty(4)
     for k in range(4):
         tension[0, k] = drive_n[k]
         sens[0, k] = 1.0
@@ -109,8 +111,8 @@ def _walk(drive_n, h_mm, ei_nmm2, r_mm, give_mm_per_n, cos_phi, sin_phi, ea_axia
                 # proximal tension: this only steers the sensitivity)
                 wrap_per_n = 0.0
                 if bend > 0.0:
-                    slope = _moment_slope(r_mm[i], give_mm_per_n[i], _arm(r_mm[i], give_mm_per_n[i], tension[i - 1, k]))
-                    wrap_per_n = h_mm * slope * (ky * cos_phi[i, k] - kx * sin_phi[i, k]) / (bend * ei_nmm2[i])
+                    lever = _moment_slope(r_mm[i], give_mm_per_n[i], _arm(r_mm[i], give_mm_per_n[i], tension[i - 1, k]))
+                    wrap_per_n = h_mm * lever * (ky * cos_phi[i, k] - kx * sin_phi[i, k]) / (bend * ei_nmm2[i])
                 tension[i, k], sens[i, k] = clamp_to_capstan(tension_prev[i, k], tension[i - 1, k], sens[i - 1, k],
                                                              mu[k], wrap, wrap_per_n, c0_h)
                 if tension[i, k] < 0.0:
@@ -142,6 +144,8 @@ def _walk(drive_n, h_mm, ei_nmm2, r_mm, give_mm_per_n, cos_phi, sin_phi, ea_axia
         total = tension[i, 0] + tension[i, 1] + tension[i, 2] + tension[i, 3]
         dkx = kappa[i, 0] - kappa_set[i, 0]
         dky = kappa[i, 1] - kappa_set[i, 1]
+        for j in range(4):
+            slope[j] = _moment_slope(r_mm[i], give_mm_per_n[i], arm[i, j])
         for k in range(4):
             ck = cos_phi[i, k]
             sk = sin_phi[i, k]
@@ -151,8 +155,7 @@ def _walk(drive_n, h_mm, ei_nmm2, r_mm, give_mm_per_n, cos_phi, sin_phi, ea_axia
                 if sens[i, j] == 0.0:
                     continue
                 # cos(phi_k - phi_j) = cos phi_k cos phi_j + sin phi_k sin phi_j
-                slope = _moment_slope(r_mm[i], give_mm_per_n[i], arm[i, j])
-                g = arm[i, k] * slope * (ck * cos_phi[i, j] + sk * sin_phi[i, j]) / ei_nmm2[i] + 1.0 / ea_axial_n[i]
+                g = arm[i, k] * slope[j] * (ck * cos_phi[i, j] + sk * sin_phi[i, j]) / ei_nmm2[i] + 1.0 / ea_axial_n[i]
                 if k == j:
                     g += 1.0 / ea_tendon_n - give_mm_per_n[i] * arm[i, k] * arm[i, k] / (r_mm[i] * r_mm[i]) * shortening
                 jacobian[k, j] += w * sens[i, j] * g
