@@ -29,7 +29,10 @@ E_KAPPA0_X = 10
 E_KAPPA0_Y = 11
 E_CREEP_COMPLIANCE = 12
 E_CREEP_TIME = 13
-N_KERNEL_TERMS = 14
+E_SENSOR_X = 14
+E_SENSOR_Y = 15
+E_SENSOR_Z = 16
+N_KERNEL_TERMS = 17
 
 
 @dataclass(frozen=True)
@@ -50,7 +53,8 @@ class EffectTerms:
     drive_creep_mm_per_n, drive_creep_time_s: viscoelastic creep of the drive line (standard
         linear solid): a stretch s_c with s_c + tau*ds_c/dt = c_creep*T_drive, in series with the
         elastic stretch, so the tip sees u - c*T_drive - s_c (quasi_static_kernel.drive_creep).
-    tracker_offset_mm: rigid registration error of the tip sensor (added to the tip).
+    tracker_offset_mm: the tip sensor's mount offset d in the tip frame: the tracker reports
+        p_tip + R_tip d, so the offset turns with the tip (a coil beside or behind the tip centre).
     """
 
     tendon_compliance_mm_per_n: float = 0.0
@@ -98,4 +102,5 @@ class EffectTerms:
         v[E_KAPPA0_X:E_KAPPA0_Y + 1] = self.precurvature_per_mm
         v[E_CREEP_COMPLIANCE] = self.drive_creep_mm_per_n
         v[E_CREEP_TIME] = self.drive_creep_time_s
+        v[E_SENSOR_X:E_SENSOR_Z + 1] = self.tracker_offset_mm
         return v

@@ -56,10 +56,12 @@ EFFECTS: dict[str, CandidateEffect] = {e.id: e for e in (
         apply=lambda t, v: t.replace(twist_rad=v[0])),
     CandidateEffect(
         id="tracker_offset",
-        physics="a rigid registration error of the tip sensor: a constant offset of the measured tip",
+        physics="the tip sensor mounted off the tip centre: the tracker reports p_tip + R_tip d, with d "
+                "(dx, dy, dz) fixed in the tip frame, so the offset turns with the tip",
         param_names=("dx_mm", "dy_mm", "dz_mm"), typical=(1.0, -0.8, 0.6),
         lower=(-10.0, -10.0, -10.0), upper=(10.0, 10.0, 10.0),
-        signature="a constant bias everywhere: adding it removes error in every region of the motion",
+        signature="an offset that turns with the tip, constant at zero load: adding it removes error in "
+                  "every region of the motion",
         signature_region="every region",
         apply=lambda t, v: t.replace(tracker_offset_mm=(v[0], v[1], v[2]))),
     CandidateEffect(
