@@ -79,8 +79,9 @@ class DahlCatheter:
     Inputs: tendon displacements [mm] (positive = pulled) for tendons at 0, 90, 180, 270 deg,
     and the insertion, i.e. the free length [mm] out of the support tube. Outputs are in the
     base frame: origin at the tube exit, z out of the tube, x toward tendon 1.
-    The tip is reported as the tip sensor sees it: p_tip + R_tip d, with d =
-    `effects.tracker_offset_mm` the sensor's mount offset in the tip frame (0 by default).
+    The tip is reported as the tracker sees it: p_tip + R_tip d + o, with d =
+    `effects.sensor_offset_mm` the sensor's mount offset in the tip frame and o =
+    `effects.tracker_offset_mm` the tracker's registration offset in the base frame (0 by default).
 
     Motion is quasi-static: each input change is followed in sub-steps of at most
     `max_tendon_step_mm` of tendon and `max_insertion_step_mm` of insertion, so the friction
@@ -118,7 +119,8 @@ class DahlCatheter:
         self.max_time_step_s = float(max_time_step_s)
         self._kernel_params = self._pack(params)
         self._kernel_effects = effects.kernel_vector()
-        self._sensor_offset_mm = np.asarray(effects.tracker_offset_mm, dtype=float)
+        self._sensor_offset_mm = np.asarray(effects.sensor_offset_mm, dtype=float)
+        self._tracker_offset_mm = np.asarray(effects.tracker_offset_mm, dtype=float)
         self._point_loads = np.empty((0, 4))     # (fx, fy, fz [N], distance from the tip [mm])
         self.reset()
 
@@ -272,7 +274,7 @@ class DahlCatheter:
     # -- outputs -----------------------------------------------------------------------
     @property
     def tip_mm(self) -> np.ndarray:
-        return self.state.points_mm[-1] + self.state.frames[-1] @ self._sensor_offset_mm
+        return self.state.points_mm[-1] + self.state.frames[-1] @ self._sensor_offset_mm + self._tracker_offset_mm
 
     @property
     def backbone_mm(self) -> np.ndarray:

@@ -32,7 +32,10 @@ E_CREEP_TIME = 13
 E_SENSOR_X = 14
 E_SENSOR_Y = 15
 E_SENSOR_Z = 16
-N_KERNEL_TERMS = 17
+E_TRACKER_X = 17
+E_TRACKER_Y = 18
+E_TRACKER_Z = 19
+N_KERNEL_TERMS = 20
 
 
 @dataclass(frozen=True)
@@ -53,8 +56,10 @@ class EffectTerms:
     drive_creep_mm_per_n, drive_creep_time_s: viscoelastic creep of the drive line (standard
         linear solid): a stretch s_c with s_c + tau*ds_c/dt = c_creep*T_drive, in series with the
         elastic stretch, so the tip sees u - c*T_drive - s_c (quasi_static_kernel.drive_creep).
-    tracker_offset_mm: the tip sensor's mount offset d in the tip frame: the tracker reports
-        p_tip + R_tip d, so the offset turns with the tip (a coil beside or behind the tip centre).
+    sensor_offset_mm: the tip sensor's mount offset d in the tip frame (a coil beside or behind the
+        tip centre): it turns with the tip.
+    tracker_offset_mm: the tracker's registration error o in the base frame: a constant offset.
+        The tip is reported as p_tip + R_tip d + o.
     """
 
     tendon_compliance_mm_per_n: float = 0.0
@@ -68,6 +73,7 @@ class EffectTerms:
     precurvature_per_mm: tuple[float, float] = (0.0, 0.0)
     drive_creep_mm_per_n: float = 0.0
     drive_creep_time_s: float = 0.2
+    sensor_offset_mm: tuple[float, float, float] = (0.0, 0.0, 0.0)
     tracker_offset_mm: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def __post_init__(self) -> None:
@@ -102,5 +108,6 @@ class EffectTerms:
         v[E_KAPPA0_X:E_KAPPA0_Y + 1] = self.precurvature_per_mm
         v[E_CREEP_COMPLIANCE] = self.drive_creep_mm_per_n
         v[E_CREEP_TIME] = self.drive_creep_time_s
-        v[E_SENSOR_X:E_SENSOR_Z + 1] = self.tracker_offset_mm
+        v[E_SENSOR_X:E_SENSOR_Z + 1] = self.sensor_offset_mm
+        v[E_TRACKER_X:E_TRACKER_Z + 1] = self.tracker_offset_mm
         return v

@@ -52,7 +52,7 @@ from model.backbone_geometry import compose_backbone
 from model.dahl_friction import capstan_gain, dahl_update_with_slopes
 from model.effect_terms import (E_BACKLASH, E_CREEP_COMPLIANCE, E_CREEP_TIME, E_GX, E_GY, E_GZ, E_KAPPA0_X,
                                 E_KAPPA0_Y, E_LUMEN_COEF, E_LUMEN_EXTENT, E_RATE, E_SENSOR_X, E_TENDON_COMPLIANCE,
-                                E_TUBE_PLAY, E_TWIST)
+                                E_TRACKER_X, E_TUBE_PLAY, E_TWIST)
 from model.linear_algebra import solve_in_place
 
 # Positions in the kernel's parameter vector (see DahlCatheter._kernel_params).
@@ -764,9 +764,9 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
              iteration_budget, params, effects, point_loads, applied_tendon_mm, applied_insertion_mm, friction,
              sliding, last_step, tension, last_tension_step, bend, compression, tip_tension, drive_tension, slack,
              points, frames, scalars, tips_out, drive_tension_out, max_time_step_s, bend_rate, creep):
-    """Drive the model along a sampled input path; tips_out[t] is the tip as its sensor sees it
-    (p_tip + R_tip d, d the sensor's mount offset in the tip frame) and drive_tension_out[t] the
-    tendon tensions at the drives after sample t.
+    """Drive the model along a sampled input path; tips_out[t] is the tip as the tracker sees it
+    (p_tip + R_tip d + o: d the sensor's mount offset in the tip frame, o the tracker's registration
+    offset in the base frame) and drive_tension_out[t] the tendon tensions at the drives after sample t.
 
     Returns the number of samples done: all of them, unless the Newton iterations of this call
     exceed iteration_budget (inf: no budget), where it stops at once (mid-sample, the state then
@@ -859,10 +859,10 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
             applied_tendon_mm[k] = target[k]
         applied_insertion_mm[0] = length_target
         nb = points.shape[0] - 1
-        for a in range(3):      # the tip sensor: p_tip + R_tip d (tracker_offset_mm)
+        for a in range(3):      # as the tracker sees it: p_tip + R_tip d + o
             tips_out[t, a] = points[nb, a] + (frames[nb, a, 0] * effects[E_SENSOR_X]
                                               + frames[nb, a, 1] * effects[E_SENSOR_X + 1]
-                                              + frames[nb, a, 2] * effects[E_SENSOR_X + 2])
+                                              + frames[nb, a, 2] * effects[E_SENSOR_X + 2]) + effects[E_TRACKER_X + a]
         for k in range(4):
             drive_tension_out[t, k] = drive_tension[k]
     return n_samples

@@ -39,6 +39,8 @@ DAHL_EFFECT_RANGES: dict[str, dict] = {effect_id: {"in_catalog": True, "params":
     "gravity": {"g_x_m_s2": _signed(0.3, 14.0), "g_y_m_s2": _signed(0.3, 14.0)},
     "torsion": {"twist_rad": _signed(0.015, 0.375)},
     "tracker_offset": {"dx_mm": _signed(0.03, 1.5), "dy_mm": _signed(0.03, 1.5), "dz_mm": _signed(0.03, 1.5)},
+    "sensor_offset": {"dx_tip_mm": _signed(0.03, 1.5), "dy_tip_mm": _signed(0.03, 1.5),
+                      "dz_tip_mm": _signed(0.03, 1.5)},
     "rate_friction": {"coef_s_per_mm": _log(0.006, 0.15)},
     "precurvature": {"kappa_x_per_mm": _signed(1e-4, 2.5e-3), "kappa_y_per_mm": _signed(1e-4, 2.5e-3)},
     "rate_lag": {"compliance_mm_per_n": _log(0.003, 0.08), "time_s": _log(0.05, 1.0)},

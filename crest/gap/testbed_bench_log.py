@@ -33,7 +33,8 @@ from crest.session import SessionOptions, open_session
 from model import CatheterParams
 from model.effects import effect
 
-RECIPE = "testbed-v1"          # change when the draw or the recording changes: the cache is then re-recorded
+RECIPE = "testbed-v2"   # change when the draw, the plant or the recording changes: the cache is then re-recorded
+                        # (v2: the tracker offset turns with the tip, 82d9cb6)
 RECORD_TIMEOUT_S = 3600.0
 OFF_PRIOR = ("bending_stiffness_nmm2", "axial_stiffness_n", "sigma_n_per_mm2", "mu", "fsc_n_per_mm")
 

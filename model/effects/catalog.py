@@ -56,14 +56,23 @@ EFFECTS: dict[str, CandidateEffect] = {e.id: e for e in (
         apply=lambda t, v: t.replace(twist_rad=v[0])),
     CandidateEffect(
         id="tracker_offset",
-        physics="the tip sensor mounted off the tip centre: the tracker reports p_tip + R_tip d, with d "
-                "(dx, dy, dz) fixed in the tip frame, so the offset turns with the tip",
+        physics="a rigid registration error of the tracker: a constant offset of the measured tip in the "
+                "base frame",
         param_names=("dx_mm", "dy_mm", "dz_mm"), typical=(1.0, -0.8, 0.6),
+        lower=(-10.0, -10.0, -10.0), upper=(10.0, 10.0, 10.0),
+        signature="a constant bias everywhere: adding it removes error in every region of the motion",
+        signature_region="every region",
+        apply=lambda t, v: t.replace(tracker_offset_mm=(v[0], v[1], v[2]))),
+    CandidateEffect(
+        id="sensor_offset",
+        physics="the tip sensor mounted off the tip centre: the tracker reports p_tip + R_tip d, with d "
+                "fixed in the tip frame, so the offset turns with the tip",
+        param_names=("dx_tip_mm", "dy_tip_mm", "dz_tip_mm"), typical=(1.0, -0.8, 0.6),
         lower=(-10.0, -10.0, -10.0), upper=(10.0, 10.0, 10.0),
         signature="an offset that turns with the tip, constant at zero load: adding it removes error in "
                   "every region of the motion",
         signature_region="every region",
-        apply=lambda t, v: t.replace(tracker_offset_mm=(v[0], v[1], v[2]))),
+        apply=lambda t, v: t.replace(sensor_offset_mm=(v[0], v[1], v[2]))),
     CandidateEffect(
         id="rate_friction",
         physics="velocity-strengthening tendon friction: Fs*(1 + c*|v|)",

@@ -18,7 +18,7 @@ def test_result_matches_the_documented_json_shape():
         assert total <= 1.0 + 1e-9
     assert {c["effect"] for c in result["candidates"]} == {
         "tendon_elasticity", "backlash", "lumen_compression", "tube_friction", "gravity", "torsion",
-        "tracker_offset", "rate_friction", "precurvature", "rate_lag"}
+        "tracker_offset", "sensor_offset", "rate_friction", "precurvature", "rate_lag"}
     for c in result["candidates"]:
         assert isinstance(c["params"], dict) and isinstance(c["holdout_rmse_mm"], float)
         assert isinstance(c["shrink"], float)

@@ -74,6 +74,12 @@ ROD_EFFECTS: dict[str, RodEffect] = {e.id: e for e in (
               "helix_rad_per_mm along the shaft (from the tip, fixed to the material)",
               {"helix_rad_per_mm": _p(0.003, 0.0005, 0.012, "log_signed", (-0.05, 0.05))}),
     RodEffect("tracker_offset",
+              "the tracker registered to the base with a translation error (registration_x, "
+              "registration_y, registration_z) in the base frame: every measured tip is shifted alike",
+              {"registration_x_mm": _p(1.0, 0.2, 3.0, "log_signed", (-10.0, 10.0)),
+               "registration_y_mm": _p(-0.8, 0.2, 3.0, "log_signed", (-10.0, 10.0)),
+               "registration_z_mm": _p(0.6, 0.2, 3.0, "log_signed", (-10.0, 10.0))}),
+    RodEffect("sensor_offset",
               "the tracker's sensor coil mounted off the tip centre, at (sensor_x, sensor_y, sensor_z) "
               "in the tip's frame: it turns with the tip",
               {"sensor_x_mm": _p(1.0, 0.2, 3.0, "log_signed", (-10.0, 10.0)),

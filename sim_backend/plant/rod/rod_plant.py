@@ -22,7 +22,8 @@ Each step (quasi-static, step_solver.py does the rod and tendons):
    shaft's mass is neglected: the curvature relaxes to the static shape with time constant tau).
 4. Creep (sheath_creep): the rest curvature relaxes toward f (kappa - kappa_set),
    kappa_c += (f (kappa - kappa_set) - kappa_c) (1 - exp(-dt / tau)).
-5. The tip: the last node, plus the sensor's mount offset turned by the tip frame (tracker_offset).
+5. The tip as the tracker sees it: the last node, plus the sensor's mount offset turned by the tip
+   frame (sensor_offset), plus the registration error in the base frame (tracker_offset).
 
 Output: (tip_mm (3,), tension at the drives (4,)), the plant protocol of plant_protocol.py.
 """
@@ -61,9 +62,11 @@ class RodPlant:
         self._play_mm = fx.get("backlash", {}).get("gear_play_mm", 0.0)
         tube = fx.get("tube_friction")
         self._tube_play_mm = tube["grip_friction_n"] / tube["shaft_stiffness_n_per_mm"] if tube else 0.0
-        sensor = fx.get("tracker_offset", {})
+        sensor = fx.get("sensor_offset", {})
         self._sensor_mm = np.array([sensor.get("sensor_x_mm", 0.0), sensor.get("sensor_y_mm", 0.0),
                                     sensor.get("sensor_z_mm", 0.0)])
+        registration = fx.get("tracker_offset", {})
+        self._registration_mm = np.array([registration.get(f"registration_{axis}_mm", 0.0) for axis in "xyz"])
         self._mu_rate = fx.get("rate_friction", {}).get("mu_rate_s_per_mm", 0.0)
         creep = fx.get("sheath_creep", {})
         self._creep_fraction = creep.get("creep_fraction", 0.0)
@@ -115,7 +118,7 @@ class RodPlant:
             relax = 1.0 - math.exp(-dt_s / self._creep_tau_s)
             self.creep_per_mm += (self._creep_fraction * (self.kappa_per_mm - nodes["kappa_set"])
                                   - self.creep_per_mm) * relax
-        tip = self.position_mm[-1] + self.rotation[-1] @ self._sensor_mm
+        tip = self.position_mm[-1] + self.rotation[-1] @ self._sensor_mm + self._registration_mm
         return tip, self.drive_tension_n.copy()
 
     def _follow(self, start_mm, pull_mm, substeps: int, nodes: dict, mu, kappa_rest, dt_s: float) -> float:

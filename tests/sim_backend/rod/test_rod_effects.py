@@ -49,13 +49,18 @@ def test_creep_keeps_bending_during_a_hold():
     assert np.linalg.norm(end - start) > 0.3      # the tip drifts at a constant drive input
 
 
-def test_the_tracker_sensor_offset_turns_with_the_tip():
+def test_the_sensor_offset_turns_with_the_tip_and_the_tracker_offset_does_not():
     offset = {"sensor_x_mm": 0.0, "sensor_y_mm": 0.0, "sensor_z_mm": 2.0}
-    plain, mounted = RodPlant(description()), RodPlant(description(effects={"tracker_offset": offset}))
+    registration = {"registration_x_mm": 1.0, "registration_y_mm": -0.5, "registration_z_mm": 0.25}
+    plain, mounted = RodPlant(description()), RodPlant(description(effects={"sensor_offset": offset}))
+    registered = RodPlant(description(effects={"tracker_offset": registration}))
     for u in np.linspace(0.0, 5.0, 50):
         tip, _ = plain.step(DT_S, [u, 0.0, -u, 0.0], 80.0)
         sensor, _ = mounted.step(DT_S, [u, 0.0, -u, 0.0], 80.0)
+        shifted, _ = registered.step(DT_S, [u, 0.0, -u, 0.0], 80.0)
+        assert np.allclose(shifted - tip, (1.0, -0.5, 0.25), atol=1e-9)
     assert np.allclose(sensor - tip, 2.0 * plain.rotation[-1][:, 2], atol=1e-9)
+    assert plain.rotation[-1][0, 2] > 0.5      # bent far enough that the two differ
 
 
 def test_lumen_compression_takes_the_arm_the_tendon_load_pushes_in_and_straightens_the_base():
