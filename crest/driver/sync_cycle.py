@@ -7,6 +7,19 @@ has passed (a drive that did not answer is marked not fresh, its heartbeat decid
 is lost). Work that does not need this SYNC's replies (``meanwhile``, e.g. the next set-point of
 a feedforward controller) runs after the SYNC is sent, while the drives answer it.
 
+A TPDO1 carries no SYNC counter, so a reply that comes after its cycle gave up on it would pass
+for the next SYNC's answer, and a log row would hold the drive's state of one SYNC earlier. So a
+drive that did not answer owes that reply: in the next cycle its first TPDO1 pays the debt (the
+late answer, not fresh), and only a second one answers the new SYNC. A debt is one reply at most,
+and one the next cycle cannot settle is dropped: after a reply that never comes (a dropped frame,
+a drive that fell silent), the drive is in step again a cycle later, not behind for good.
+
+``first_reply_timeout_s`` is the patience for the first reply of a SYNC from any drive, where it
+is longer than ``reply_timeout_s`` (simulated time: the drives' process only answers late when
+its host is busy, since the testbed's time waits for the SYNCs). Once one drive has answered, the
+others get ``reply_timeout_s``, and a cycle in which no drive answered at all is followed by one
+with the ordinary patience (a testbed that is gone is found by the heartbeats, not waited for).
+
 ``quick_stop_all`` may be called from any thread: under the send lock it replaces every
 controlword by quick stop, sends it to every drive at once, and keeps sending it in every
 later cycle.
@@ -32,11 +45,13 @@ class SyncCycle:
     """The bus side of the control cycle for ``axes``.
 
     :param reply_timeout_s: wall time to wait for the TPDOs after a SYNC.
+    :param first_reply_timeout_s: wall time to wait for the first of them (module doc); at most
+        ``reply_timeout_s`` means no extra patience.
     """
 
     def __init__(self, network: canopen.Network, clock: Clock, axes: Sequence[DriveAxis], period_s: float,
                  heartbeat: HeartbeatProducer, feedback_changed: threading.Condition,
-                 reply_timeout_s: float) -> None:
+                 reply_timeout_s: float, first_reply_timeout_s: float = 0.0) -> None:
         self._network = network
         self._clock = clock
         self.axes = tuple(axes)
@@ -44,6 +59,9 @@ class SyncCycle:
         self._heartbeat = heartbeat
         self._feedback_changed = feedback_changed
         self.reply_timeout_s = reply_timeout_s
+        self.first_reply_timeout_s = first_reply_timeout_s
+        self._late_reply_at: list[int | None] = [None] * len(self.axes)   # tpdo_count once an owed reply came
+        self._any_reply_last_cycle = True
         self._send_lock = threading.Lock()
         self._override: int | None = None
         self.next_sync_s: float | None = None
@@ -65,6 +83,7 @@ class SyncCycle:
         self._heartbeat.poll(now_s)
         with self._feedback_changed:
             marks = [axis.tpdo_count for axis in self.axes]
+            owed = [int(due is not None and mark < due) for mark, due in zip(marks, self._late_reply_at)]
         with self._send_lock:
             for axis in self.axes:
                 self._network.send_message(axis.rpdo_cob_id, axis.rpdo_data(self._override))
@@ -73,11 +92,19 @@ class SyncCycle:
         self.count += 1
         if meanwhile is not None:
             meanwhile()
+
+        def answered() -> list[bool]:
+            return [axis.tpdo_count > mark + debt for axis, mark, debt in zip(self.axes, marks, owed)]
+
         with self._feedback_changed:
-            self._feedback_changed.wait_for(
-                lambda: all(axis.tpdo_count > mark for axis, mark in zip(self.axes, marks)),
-                timeout=self.reply_timeout_s)
-            fresh = tuple(axis.tpdo_count > mark for axis, mark in zip(self.axes, marks))
+            if self.first_reply_timeout_s > self.reply_timeout_s and self._any_reply_last_cycle:
+                self._feedback_changed.wait_for(lambda: any(answered()), timeout=self.first_reply_timeout_s)
+            self._feedback_changed.wait_for(lambda: all(answered()), timeout=self.reply_timeout_s)
+            fresh = tuple(answered())
+            received = [axis.tpdo_count - mark for axis, mark in zip(self.axes, marks)]
+        self._any_reply_last_cycle = any(received)
+        self._late_reply_at = [mark + 1 if not is_fresh and count == 0 else None
+                               for mark, is_fresh, count in zip(marks, fresh, received)]
         return now_s, fresh
 
     def _following_sync_s(self, now_s: float) -> float:
