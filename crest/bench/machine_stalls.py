@@ -8,27 +8,20 @@ just before (`machine_floor`). It runs alone, not beside the stack: a process wa
 millisecond at a priority above the stack's threads would take its own share of their CPUs.
 
 The probe is a process of its own that does nothing but sleep to absolute deadlines every
-`period_s`, under SCHED_FIFO at `priority` (nothing of lower priority can run in its way), on one
-CPU if it is given one. Each wake-up later than STALL_THRESHOLD_S is a stall of the machine: the
-interval [wake - lateness, wake]. It reads stdin and stops when stdin closes (also when its parent
-dies), then prints its report as one JSON line.
+`period_s`, under SCHED_FIFO at `priority` (nothing of lower priority can run in its way). Each
+wake-up later than STALL_THRESHOLD_S is a stall of the machine: the interval [wake - lateness,
+wake]. It reads stdin and stops when stdin closes (also when its parent dies), then prints its
+report as one JSON line.
 
-    python -m crest.bench.machine_stalls PERIOD_S PRIORITY [CPU]
-
-Beside the stack (`probes_beside`, one pinned to each CPU), the probes take a few per cent of a CPU
-(a wake-up every millisecond), and what they record tells which of the stack's missed cycles the
-machine's stalls explain (crest.bench.missed_cycles).
+    python -m crest.bench.machine_stalls PERIOD_S PRIORITY
 """
 from __future__ import annotations
 
 import json
-import os
 import select
 import subprocess
 import sys
 import time
-from collections.abc import Iterator, Sequence
-from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
 
 from crest.driver.realtime_scheduling import realtime_threads
@@ -61,17 +54,15 @@ class StallReport:
 class MachineStallProbe:
     """The probe process, for a `with` block: `report` holds what it saw once the block ends."""
 
-    def __init__(self, priority: int = PROBE_PRIORITY, period_s: float = PROBE_PERIOD_S, cpu: int | None = None):
+    def __init__(self, priority: int = PROBE_PRIORITY, period_s: float = PROBE_PERIOD_S):
         self.priority = priority
         self.period_s = period_s
-        self.cpu = cpu
         self.report: StallReport | None = None
         self._process: subprocess.Popen | None = None
 
     def __enter__(self) -> "MachineStallProbe":
         self._process = subprocess.Popen(
-            [sys.executable, "-m", "crest.bench.machine_stalls", repr(self.period_s), str(self.priority)]
-            + ([] if self.cpu is None else [str(self.cpu)]),
+            [sys.executable, "-m", "crest.bench.machine_stalls", repr(self.period_s), str(self.priority)],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
         first = self._process.stdout.readline().strip()
         if first != READY:
@@ -100,31 +91,19 @@ def machine_floor(duration_s: float, priority: int = PROBE_PRIORITY) -> StallRep
     return probe.report
 
 
-@contextmanager
-def probes_beside(cpus: Sequence[int], priority: int = PROBE_PRIORITY) -> Iterator[list[MachineStallProbe]]:
-    """One probe pinned to each of `cpus` (unpinned where none are named) for the block; their
-    reports are there once it ends. A stall on any CPU can hold up a SYNC: the master sends it on
-    one, the testbed's bus stamps it on the other."""
-    with ExitStack() as stack:
-        yield [stack.enter_context(MachineStallProbe(priority, cpu=cpu)) for cpu in (cpus or [None])]
-
-
 def parse_report(line: str) -> StallReport:
     raw = json.loads(line)
     return StallReport(scheduling=raw["scheduling"], wakeups=int(raw["wakeups"]),
                        stalls=tuple((float(start), float(end)) for start, end in raw["stalls"]))
 
 
-def probe(period_s: float, priority: int, cpu: int | None = None) -> dict:
-    """Wake every `period_s` until stdin closes, on `cpu` alone if given; the report as a dict (see
-    the module doc).
+def probe(period_s: float, priority: int) -> dict:
+    """Wake every `period_s` until stdin closes; the report as a dict (see the module doc).
 
     The k-th deadline is start + k period (absolute, so a late wake-up does not shift the later
     ones); a wake-up `late` seconds after its deadline records the stall [now - late, now].
     """
     stalls, wakeups = [], 0
-    if cpu is not None:
-        os.sched_setaffinity(0, {cpu})
     with realtime_threads(priority) as scheduling:
         print(READY, flush=True)
         start = time.monotonic()
@@ -145,5 +124,4 @@ def probe(period_s: float, priority: int, cpu: int | None = None) -> dict:
 
 
 if __name__ == "__main__":
-    print(json.dumps(probe(float(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3]) if len(sys.argv) > 3 else None)),
-          flush=True)
+    print(json.dumps(probe(float(sys.argv[1]), int(sys.argv[2]))), flush=True)

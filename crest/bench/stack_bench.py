@@ -8,10 +8,7 @@ what each process got.
 
 Measured from the SYNC frames on the bus (a further handle on the bus timestamps them):
 the achieved rate, the period jitter (|period - nominal|, p50/p99), missed cycles (a period
-longer than 1.5 nominal periods) and the bus load the traffic would put on a real bus. While the
-stack runs, an idle real-time probe on each CPU records the machine's own stalls
-(crest.bench.machine_stalls), and each missed cycle is put down to the machine or to the stack
-(crest.bench.missed_cycles).
+longer than 1.5 nominal periods) and the bus load the traffic would put on a real bus.
 """
 from __future__ import annotations
 
@@ -27,15 +24,12 @@ import can
 import numpy as np
 
 from control import Articulation, make_controller
-from crest.bench.machine_stalls import PROBE_PRIORITY, probes_beside
-from crest.bench.missed_cycles import attribute_missed_cycles
 from crest.config import default_config_path, load_testbed_config
 from crest.driver import SafetyStop
 from crest.experiment.builtin_trajectories import BuiltinOptions, builtin_trajectory
 from crest.experiment.controlled_run import run_with_controller
 from crest.experiment.workspace_from_config import limits_for, workspace_for
 from crest.session import SessionOptions, open_session
-from crest.testbed_service.cpu_split import allowed_cpus
 from crest.testbed_service.auto_start import MODE_VARIABLE
 from model import CatheterParams
 from sim_backend.bus_load import BusLoadMeter
@@ -110,7 +104,6 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
                                                    circle_period_s=circle_period_s), period_s, start)
     controller = make_controller(controller_name, workspace, limits, period_s)
     stopped, rms_tip_error_mm = None, None
-    machine_cpus = allowed_cpus()           # all of them: the session pins this process to some
     with open_session(SessionOptions(config=config)) as session:
         session.testbed.home()
         # into cyclic synchronous position before the timing starts: the change of operation mode is
@@ -121,8 +114,7 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
         meter = BusLoadMeter(config.bus.bitrate, period_s)      # what the frames on the wire take
         notifier = can.Notifier(monitor, [listener, meter], timeout=0.1)
         try:
-            with probes_beside(machine_cpus, max(PROBE_PRIORITY, config.sync.realtime_priority + 1)) as probes:
-                rms_tip_error_mm = run_with_controller(session, trajectory, controller).rms_tip_error_mm
+            rms_tip_error_mm = run_with_controller(session, trajectory, controller).rms_tip_error_mm
         except SafetyStop as stop:
             stopped = str(stop)
         finally:
@@ -136,19 +128,13 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
     stamps = np.array(listener.timestamps)
     periods = np.diff(stamps)
     jitter = np.abs(periods - period_s)
-    stalls = [stall for probe in probes for stall in probe.report.stalls]
-    missed = attribute_missed_cycles(stamps, period_s, stalls)
+    missed = int(np.sum(periods > 1.5 * period_s))
     return {"sync_rate_hz_nominal": sync_rate_hz, "duration_s": float(stamps[-1] - stamps[0]),
             "controller": controller_name, "cycles": int(len(periods)),
             "achieved_rate_hz": float(len(periods) / (stamps[-1] - stamps[0])),
             "jitter_p50_ms": float(1e3 * np.percentile(jitter, 50)),
             "jitter_p99_ms": float(1e3 * np.percentile(jitter, 99)),
-            "missed_cycles": missed.total, "missed_in_machine_stalls": missed.in_machine_stalls,
-            "missed_by_the_stack": missed.by_the_stack, "stack_late_ms": list(missed.stack_late_ms),
-            "machine_stalls_beside": {"probes": [probe.report.scheduling for probe in probes],
-                                      "cpus": [probe.cpu for probe in probes], "stalls": len(stalls),
-                                      "stalls_over_1_ms": sum(end - start > 0.001 for start, end in stalls)},
-            "longest_period_ms": float(1e3 * periods.max()),
+            "missed_cycles": missed, "longest_period_ms": float(1e3 * periods.max()),
             "bus_load_mean": float(load.mean_load), "bus_load_max": float(load.max_load),
             "bus_bitrate_bit_s": int(load.bitrate_bit_s), "cycles_over_bus_capacity": len(load.overloaded),
             "rms_tip_error_mm": rms_tip_error_mm, "plant_rate_hz": plant_rate_hz, "stopped": stopped,

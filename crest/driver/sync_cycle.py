@@ -92,15 +92,16 @@ class SyncCycle:
         self.count += 1
         if meanwhile is not None:
             meanwhile()
-
-        def answered() -> list[bool]:
-            return [axis.tpdo_count > mark + debt for axis, mark, debt in zip(self.axes, marks, owed)]
-
+        answer_at = [mark + debt + 1 for mark, debt in zip(marks, owed)]     # tpdo_count once this SYNC's came
         with self._feedback_changed:
             if self.first_reply_timeout_s > self.reply_timeout_s and self._any_reply_last_cycle:
-                self._feedback_changed.wait_for(lambda: any(answered()), timeout=self.first_reply_timeout_s)
-            self._feedback_changed.wait_for(lambda: all(answered()), timeout=self.reply_timeout_s)
-            fresh = tuple(answered())
+                self._feedback_changed.wait_for(
+                    lambda: any(axis.tpdo_count >= due for axis, due in zip(self.axes, answer_at)),
+                    timeout=self.first_reply_timeout_s)
+            self._feedback_changed.wait_for(
+                lambda: all(axis.tpdo_count >= due for axis, due in zip(self.axes, answer_at)),
+                timeout=self.reply_timeout_s)
+            fresh = tuple(axis.tpdo_count >= due for axis, due in zip(self.axes, answer_at))
             received = [axis.tpdo_count - mark for axis, mark in zip(self.axes, marks)]
         self._any_reply_last_cycle = any(received)
         self._late_reply_at = [mark + 1 if not is_fresh and count == 0 else None

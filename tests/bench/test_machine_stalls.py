@@ -6,8 +6,7 @@ import time
 
 import pytest
 
-from crest.bench.machine_stalls import MachineStallProbe, StallReport, probes_beside
-from crest.testbed_service.cpu_split import allowed_cpus
+from crest.bench.machine_stalls import MachineStallProbe, StallReport
 
 
 def test_the_probe_in_another_process_records_a_pause_of_that_process_as_a_stall():
@@ -34,18 +33,3 @@ def test_stalls_are_counted_by_their_length():
     report = StallReport("real-time (SCHED_FIFO, priority 90)", 1000, ((10.000, 10.008), (20.0, 20.0007)))
     assert report.longer_than(0.001) == 1 and report.longer_than(0.0005) == 2
     assert report.longest_ms == pytest.approx(8.0)
-
-
-def test_probes_beside_pin_one_probe_to_each_cpu_named():
-    """The kernel's own record of each probe's CPU mask (/proc/PID/status) names its one CPU."""
-    cpus = allowed_cpus()
-    with probes_beside(cpus, priority=0) as probes:
-        masks = [_cpus_allowed(probe.pid) for probe in probes]
-        time.sleep(0.2)
-    assert masks == [str(cpu) for cpu in cpus]
-    assert all(probe.report.wakeups > 0 for probe in probes)
-
-
-def _cpus_allowed(pid: int) -> str:
-    with open(f"/proc/{pid}/status") as status:
-        return next(line.split()[1] for line in status if line.startswith("Cpus_allowed_list:"))
