@@ -3,8 +3,9 @@
 A row's tip is the tip of a tracker frame that arrived since the row before, or empty (see
 tip_feed). The log is closed with the stop cause when a safety stop happens, so a stopped run
 leaves a complete, readable log; every close adds the tip coverage (rows with and without a tip,
-when the tracker was lost: tip_coverage) to the sidecar's summary. A stop after the log was
-closed (at the end of the session) still puts its cause into the sidecar.
+when the tracker was lost: tip_coverage) and, per axis, the rows in which the drive's answer to
+that SYNC did not come (drive_feedback_coverage) to the sidecar's summary. A stop after the log
+was closed (at the end of the session) still puts its cause into the sidecar.
 """
 from __future__ import annotations
 
@@ -14,6 +15,8 @@ import numpy as np
 
 from crest import __version__
 from crest.driver import CycleSample, SafetyStop
+from crest.driver.axis_targets import AXIS_ORDER
+from crest.experiment.drive_feedback_coverage import DriveFeedbackCoverage
 from crest.experiment.tip_coverage import TipCoverage
 from crest.log import BusRecorder, LogWriter
 from crest.log.log_format import catheter_dict
@@ -46,6 +49,7 @@ class ExperimentRecorder:
             self._monitor = None
             session.testbed.add_listener(self.bus)
         self.tip_coverage = TipCoverage(config.tracker.loss_timeout_s if session.tracker is not None else None)
+        self.feedback_coverage = DriveFeedbackCoverage(AXIS_ORDER)
         session.testbed.on_safety_stop(self._on_safety_stop)
         self._t0_s: float | None = None
         self.closed = False
@@ -63,12 +67,13 @@ class ExperimentRecorder:
                           sample.tendon_position_mm, sample.insertion_position_mm, tip_mm,
                           tendon_force_n=sample.tendon_tension_n, tip_ref_mm=tip_ref_mm)
         self.tip_coverage.add(sample.t_s, tip_mm is not None and bool(np.isfinite(tip_mm).all()))
+        self.feedback_coverage.add(sample.t_s, sample.fresh)
 
     def close(self, summary: dict | None = None) -> None:
         if self.closed:
             return
         self.closed = True
-        self.writer.close({**self.tip_coverage.summary(), **(summary or {})})
+        self.writer.close({**self.tip_coverage.summary(), **self.feedback_coverage.summary(), **(summary or {})})
         self.bus.close()
         if self._monitor is not None:
             self._monitor.shutdown()

@@ -50,6 +50,10 @@ def test_a_drive_fault_stops_every_axis_with_its_exit_code_and_keeps_the_log(tmp
     assert len(log) > 50
     sidecar = json.loads(log_path.with_suffix(".json").read_text())
     assert axis in sidecar["summary"]["stop_cause"]
+    if "heartbeat" in fault:     # the silent drive's rows repeat its last answer: the summary says which
+        stale = sidecar["summary"]["rows_with_stale_drive_feedback"]
+        assert stale.get(axis, 0) >= 1, stale
+        assert 2.95 <= sidecar["summary"]["first_stale_drive_feedback_s"][axis] <= 3.1   # at the fault (@3.0)
 
 
 def test_fault_times_count_from_the_start_of_the_run(tmp_path):
