@@ -14,21 +14,19 @@ from typing import Any
 
 
 class DriveFeedbackCoverage:
-    """`add` once per row, in time order, with the row's time and each axis' freshness."""
+    """`add` once per row, in time order, with the row's time (the log's t: s since its first row)
+    and each axis' freshness."""
 
     def __init__(self, axis_names: Sequence[str]):
         self.axis_names = tuple(axis_names)
         self.stale_rows = dict.fromkeys(self.axis_names, 0)
         self.first_stale_s: dict[str, float] = {}
-        self._t0_s: float | None = None
 
     def add(self, t_s: float, fresh: Sequence[bool]) -> None:
-        if self._t0_s is None:
-            self._t0_s = t_s
         for name, is_fresh in zip(self.axis_names, fresh):
             if not is_fresh:
                 self.stale_rows[name] += 1
-                self.first_stale_s.setdefault(name, t_s - self._t0_s)
+                self.first_stale_s.setdefault(name, t_s)
 
     def summary(self) -> dict[str, Any]:
         """{"rows_with_stale_drive_feedback": {axis: rows}, "first_stale_drive_feedback_s": {axis: t}},

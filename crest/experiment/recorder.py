@@ -63,11 +63,12 @@ class ExperimentRecorder:
         last row (None when no new frame with the tool in view arrived: an empty tip)."""
         if self._t0_s is None:
             self._t0_s = sample.t_s
-        self.writer.write(sample.t_s - self._t0_s, sample.tendon_target_mm, sample.insertion_target_mm,
+        t_s = sample.t_s - self._t0_s
+        self.writer.write(t_s, sample.tendon_target_mm, sample.insertion_target_mm,
                           sample.tendon_position_mm, sample.insertion_position_mm, tip_mm,
                           tendon_force_n=sample.tendon_tension_n, tip_ref_mm=tip_ref_mm)
         self.tip_coverage.add(sample.t_s, tip_mm is not None and bool(np.isfinite(tip_mm).all()))
-        self.feedback_coverage.add(sample.t_s, sample.fresh)
+        self.feedback_coverage.add(t_s, sample.fresh)
 
     def close(self, summary: dict | None = None) -> None:
         if self.closed:

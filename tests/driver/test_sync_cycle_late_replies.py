@@ -29,11 +29,8 @@ class StubAxis:
 
 
 class StubNetwork:
-    def __init__(self):
-        self.sent: list[int] = []
-
     def send_message(self, cob_id: int, data: bytes) -> None:
-        self.sent.append(cob_id)
+        pass
 
 
 class NoHeartbeat:
