@@ -27,7 +27,7 @@ from control import Articulation, make_controller
 from crest.config import default_config_path, load_testbed_config
 from crest.driver import SafetyStop
 from crest.experiment.builtin_trajectories import BuiltinOptions, builtin_trajectory
-from crest.experiment.controlled_run import run_with_controller
+from crest.experiment.controlled_run import commands_in_own_process, run_with_controller
 from crest.experiment.workspace_from_config import limits_for, workspace_for
 from crest.session import SessionOptions, open_session
 from crest.testbed_service.auto_start import MODE_VARIABLE
@@ -103,7 +103,7 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
                                     BuiltinOptions(articulation_deg=90.0, periods=turns,
                                                    circle_period_s=circle_period_s), period_s, start)
     controller = make_controller(controller_name, workspace, limits, period_s)
-    stopped, rms_tip_error_mm = None, None
+    stopped, rms_tip_error_mm, held_cycles = None, None, None
     with open_session(SessionOptions(config=config)) as session:
         session.testbed.home()
         # into cyclic synchronous position before the timing starts: the change of operation mode is
@@ -114,7 +114,8 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
         meter = BusLoadMeter(config.bus.bitrate, period_s)      # what the frames on the wire take
         notifier = can.Notifier(monitor, [listener, meter], timeout=0.1)
         try:
-            rms_tip_error_mm = run_with_controller(session, trajectory, controller).rms_tip_error_mm
+            result = run_with_controller(session, trajectory, controller)
+            rms_tip_error_mm, held_cycles = result.rms_tip_error_mm, result.held_cycles
         except SafetyStop as stop:
             stopped = str(stop)
         finally:
@@ -123,6 +124,7 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
         load = meter.report()
         plant_rate_hz = session.backend.virtual.plant_rate_hz if session.backend.virtual is not None else None
         master_scheduling = session.scheduling.describe()
+        command_process = commands_in_own_process(session, controller)
         testbed_scheduling = (session.backend.served.scheduling if session.backend.served is not None
                               else master_scheduling)
     stamps = np.array(listener.timestamps)
@@ -139,5 +141,6 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
             "bus_bitrate_bit_s": int(load.bitrate_bit_s), "cycles_over_bus_capacity": len(load.overloaded),
             "rms_tip_error_mm": rms_tip_error_mm, "plant_rate_hz": plant_rate_hz, "stopped": stopped,
             "realtime_priority": config.sync.realtime_priority, "master_scheduling": master_scheduling,
-            "testbed_scheduling": testbed_scheduling,
+            "testbed_scheduling": testbed_scheduling, "commands_in_own_process": command_process,
+            "cycles_held_for_a_command": held_cycles,
             "goal": "500 Hz with no missed cycle and p99 jitter <= 1 ms"}

@@ -137,10 +137,14 @@ def format_table(results: dict) -> str:
                      "-", None))
     for key, r in stacks.items():
         rows.append((f"Full stack at {r['sync_rate_hz_nominal']:.0f} Hz SYNC, {r['duration_s']:.0f} s, testbed in "
-                     f"{r['testbed']}; master: {r['master_scheduling']}, testbed: {r['testbed_scheduling']}",
+                     f"{r['testbed']}; master: {r['master_scheduling']}, testbed: {r['testbed_scheduling']}; "
+                     f"{r['controller']} commands computed "
+                     + ("ahead in a process of their own" if r["commands_in_own_process"] else "in the master"),
                      f"{r['achieved_rate_hz']:.0f} Hz, jitter p50 {r['jitter_p50_ms']:.2f} / p99 "
                      f"{r['jitter_p99_ms']:.2f} ms, {r['missed_cycles']} missed, bus load "
                      f"{100 * r['bus_load_mean']:.0f}% of {r['bus_bitrate_bit_s'] / 1e6:g} Mbit/s"
+                     + (f"; {r['cycles_held_for_a_command']} cycles held for a command not yet computed"
+                        if r["cycles_held_for_a_command"] else "")
                      + (f"; stopped: {r['stopped']}" if r["stopped"] else ""),
                      "rate held, 0 missed, p99 <= 1 ms",
                      not r["stopped"] and r["missed_cycles"] == 0 and r["jitter_p99_ms"] <= 1.0))

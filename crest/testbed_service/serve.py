@@ -16,10 +16,13 @@ command, and its fault times count from its start.
 Where the machine lets it use two CPUs or more, the testbed runs on the last one, and the commands
 that join it on the others (cpu_split.py). In real time its threads run under SCHED_FIFO at the
 configuration's [sync] realtime_priority where the system grants it
-(crest.driver.realtime_scheduling); the state file says what they got.
+(crest.driver.realtime_scheduling); the state file says what they got. Once serving, the objects
+made to serve (drives, plant, bus server) are frozen out of the garbage collector (gc.freeze): a
+full collection over them holds the drives' replies for milliseconds.
 """
 from __future__ import annotations
 
+import gc
 import os
 import signal
 import threading
@@ -66,6 +69,7 @@ def serve_until_stopped(config: TestbedConfig, *, plant: str | None = None, plan
                                    scheduling=scheduling.describe())
             publish(served)
             on_ready(served, state_path())
+            gc.freeze()     # what serving needs for good: out of the collector's full passes (module doc)
             while True:
                 signal.pause()
         finally:
