@@ -34,7 +34,7 @@ from contextlib import contextmanager
 from control import Controller, SetPoint, TendonCommand
 
 START_TIMEOUT_S = 120.0     # the first command: a fresh interpreter imports numpy and the model
-REPLY_TIMEOUT_S = 10.0      # any later one: the worker answers in milliseconds unless it is gone
+REPLY_TIMEOUT_S = 10.0      # after an answer, the next: the worker answers in milliseconds unless it is gone
 WORKER_MODULE = "crest.experiment.command_worker"
 
 
@@ -95,26 +95,37 @@ class CommandProcess:
         return self.lead - (self._submitted - self._taken)
 
     def submit(self, setpoints: Sequence[SetPoint]) -> None:
+        """Send `setpoints` to the worker (a worker that owed nothing has its patience restart)."""
         if setpoints:
+            if self._submitted - self._taken - len(self._ready) == 0:
+                self._deadline_s = time.monotonic() + self._patience_s
             self._send(list(setpoints))
             self._submitted += len(setpoints)
 
-    def has_command(self) -> bool:
-        """Whether the next command is back, without waiting; CommandProcessError if the worker is
-        gone, or silent for longer than START_TIMEOUT_S after its start or REPLY_TIMEOUT_S after the
-        last command taken."""
-        if not self._ready:
+    def ready(self) -> int:
+        """How many commands are back and not yet taken, without waiting (an error counts as one; after
+        it the worker answers nothing more, see `stopped_at_error`). CommandProcessError if the worker
+        is gone, or owes answers and has been silent for longer than START_TIMEOUT_S after its start
+        or REPLY_TIMEOUT_S after its last answer."""
+        while True:
             try:
                 self._extend(self._batches.get_nowait())
             except queue.Empty:
-                if time.monotonic() > self._deadline_s:
-                    raise CommandProcessError("the controller's command process did not answer "
-                                              f"within {self._patience_s:g} s") from None
-        return bool(self._ready)
+                break
+        owed = self._submitted - self._taken - len(self._ready)
+        if owed and not self.stopped_at_error and time.monotonic() > self._deadline_s:
+            raise CommandProcessError("the controller's command process did not answer "
+                                      f"within {self._patience_s:g} s")
+        return len(self._ready)
+
+    @property
+    def stopped_at_error(self) -> bool:
+        """The last answer back is an error: the worker will answer nothing after it."""
+        return bool(self._ready) and isinstance(self._ready[-1], Exception)
 
     def next_command(self) -> TendonCommand:
-        """The command for the next set-point submitted (waiting for it as has_command allows);
-        raises what computing it raised, or CommandProcessError when the worker is gone or silent."""
+        """The command for the next set-point submitted (waiting for it as `ready` allows); raises what
+        computing it raised, or CommandProcessError when the worker is gone or silent."""
         if self._taken >= self._submitted:
             raise ValueError("next_command: every submitted set-point has had its command")
         if not self._ready:
@@ -124,8 +135,6 @@ class CommandProcess:
                 raise CommandProcessError("the controller's command process did not answer "
                                           f"within {self._patience_s:g} s") from None
         self._taken += 1
-        self._patience_s = REPLY_TIMEOUT_S
-        self._deadline_s = time.monotonic() + REPLY_TIMEOUT_S
         command = self._ready.popleft()
         if isinstance(command, Exception):
             raise command
@@ -160,9 +169,12 @@ class CommandProcess:
             self._batches.put(None)
 
     def _extend(self, batch: list | None) -> None:
-        """A batch from the collector into the ready commands; None (the worker's end) raises."""
+        """A batch from the collector into the ready commands (the worker's patience restarts);
+        None (the worker's end) raises."""
         if batch is None:
             self._batches.put(None)     # every later call says the same
             raise CommandProcessError(f"the controller's command process exited (exit code "
                                       f"{self._process.wait()})")
         self._ready.extend(batch)
+        self._patience_s = REPLY_TIMEOUT_S
+        self._deadline_s = time.monotonic() + REPLY_TIMEOUT_S

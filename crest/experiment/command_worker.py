@@ -4,13 +4,12 @@ stdin: one pickled (controller, insertion_mm, batch), then pickled lists of set-
 stdout: pickled lists of what the controller's `command` returned for each set-point, in order, or
 the exception it raised in that place (after which the worker computes nothing more).
 A thread reads stdin into a queue, so the master's writes never wait on a computation. The worker
-runs on every CPU (the master is pinned to the CPUs a served testbed leaves it, and under SCHED_FIFO
-every real-time thread runs before the worker wherever it is, so it takes only their idle time),
-resets the controller to insertion_mm and exits when stdin closes.
+runs on the master's CPUs (those a served testbed leaves it: beside the testbed's real-time
+threads, which wake for every frame, it fell behind at 500 Hz), resets the controller to
+insertion_mm and exits when stdin closes.
 """
 from __future__ import annotations
 
-import os
 import pickle
 import queue
 import sys
@@ -18,10 +17,6 @@ import threading
 
 
 def main() -> None:
-    try:
-        os.sched_setaffinity(0, range(os.cpu_count() or 1))
-    except (AttributeError, OSError):
-        pass    # the master's CPUs, which it inherited
     commands_out = sys.stdout.buffer
     sys.stdout = sys.stderr     # a stray print must not corrupt the command stream
     setpoints_in = sys.stdin.buffer

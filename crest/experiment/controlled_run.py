@@ -168,10 +168,11 @@ class _OneAhead(_InLoop):
 
 class _FromProcess(_InLoop):
     """The commands of a controller without feedback from a CommandProcess, the set-points sent to it
-    `lead` ahead and topped up TOP_UP at a time. While the next command is not back (the worker's
-    start, a second or so, or a worker that fell behind) the testbed holds its commands, cycle by
-    cycle, without a row: the host heartbeat comes from the cycle. `held_cycles` counts the cycles
-    held after the first command."""
+    `lead` ahead and topped up TOP_UP at a time. The run starts once the worker has answered the
+    first `lead` (its start, a second or so, and its first calls, which load the model's compiled
+    kernels); whenever the next command is not back (a worker that fell behind) the testbed holds its
+    commands, cycle by cycle, without a row: the host heartbeat comes from the cycle. `held_cycles`
+    counts the cycles held once the run has started."""
 
     TOP_UP = 16
 
@@ -183,7 +184,7 @@ class _FromProcess(_InLoop):
         self.held_cycles = 0
         try:
             self._top_up()
-            self._hold_until_a_command()
+            self._hold_until_ready(len(self._queued))
         except BaseException:
             self._process.close()
             raise
@@ -198,15 +199,16 @@ class _FromProcess(_InLoop):
         self._process.submit(fresh)
         self._queued.extend(fresh)
 
-    def _hold_until_a_command(self) -> int:
+    def _hold_until_ready(self, count: int) -> int:
+        """Hold the testbed until `count` commands are back (or an error ends the answers); the cycles held."""
         held = 0
-        while not self._process.has_command():
+        while self._process.ready() < count and not self._process.stopped_at_error:
             self._testbed.cycle()
             held += 1
         return held
 
     def command(self, setpoint: SetPoint, measurement, tension_n) -> TendonCommand:
-        self.held_cycles += self._hold_until_a_command()
+        self.held_cycles += self._hold_until_ready(1)
         return self._process.next_command()
 
     def close(self) -> None:
