@@ -6,19 +6,19 @@ what was measured (``uses_feedback`` False: `cc`, `dahl`) computes its commands 
 critical path: the next set-point's command while the drives answer this cycle's SYNC, or, below
 a SYNC period of COMMAND_PROCESS_BELOW_S with the master under SCHED_FIFO, all of them ahead in a
 process of its own (crest.experiment.command_process), where they do not hold the master's
-interpreter lock. Measured at 500 Hz (`crest bench --only full_stack`, README): under SCHED_FIFO
-the process takes the missed cycles to 0; under the normal scheduler it adds them (the busy worker
-delays the wake-ups of the cycle's threads, at any nice level and even under SCHED_IDLE), so there
-the commands stay in the master. The
-commands are the same as computed one after the other, and an error in one is raised at its
-set-point, after the previous row is logged, where it would have been raised before. A controller that loses
+interpreter lock. Measured at 500 Hz (README, "Where the commands are computed"): under SCHED_FIFO
+the process took the missed cycles to 0 where the master had 5-7; under the normal scheduler it
+added them (the busy worker delays the wake-ups of the cycle's threads, at nice 19 and even under
+SCHED_IDLE), so there the commands stay in the master. The commands are the same as computed one
+after the other, and an error in one is raised at its set-point, after the previous row is logged,
+where it would have been raised before. A controller that loses
 the tracker in a closed-loop run, like the driver's own tracker watch, ends in a safety stop with
 the TRACKER_LOST exit code; an open-loop run goes on, and its result says when the tracker was
 lost and how many rows after it have a tip.
 
 For the run, the objects that exist at its start (the set-points, the model, the session) are
-frozen out of the garbage collector (gc.freeze): a full collection over them took 20-40 ms, ten to
-twenty missed SYNCs at 500 Hz, while the run's own short-lived objects are collected as before.
+frozen out of the garbage collector (gc.freeze): a full collection over them took 10-46 ms, 5 to 23
+missed SYNCs at 500 Hz, while the run's own short-lived objects are collected as before.
 """
 from __future__ import annotations
 
