@@ -76,7 +76,7 @@ def run_with_controller(session: Session, setpoints: Iterable[SetPoint], control
     controller.reset(insertion_mm=insertion_mm)
     if command_process is None:
         command_process = commands_in_own_process(session, controller)
-    commands = (_FromProcess(controller, setpoints, testbed) if command_process
+    commands = (_FromProcess(controller, setpoints, testbed, insertion_mm) if command_process
                 else _InLoop(controller, setpoints) if controller.uses_feedback else _OneAhead(controller, setpoints))
     if closed_loop:
         testbed.watch_tracker(feed.age_s)
@@ -88,6 +88,7 @@ def run_with_controller(session: Session, setpoints: Iterable[SetPoint], control
         session.start_fault_clock()
         setpoint = commands.next_setpoint()
         while setpoint is not None:
+            commands.hold_until_ready()      # before the poll: the tip logged in this row is from this cycle
             measurement = feed.poll(setpoint.t_s)
             try:
                 command = commands.command(setpoint, measurement, tension_n)
@@ -140,6 +141,9 @@ class _InLoop:
     def next_setpoint(self) -> SetPoint | None:
         return next(self._upcoming, None)
 
+    def hold_until_ready(self) -> None:
+        """Keep the testbed cycling until the next command can be had at once (here it always can)."""
+
     def command(self, setpoint: SetPoint, measurement, tension_n) -> TendonCommand:
         return self._controller.command(setpoint, measurement, drive_tension_n=tension_n)
 
@@ -176,15 +180,16 @@ class _FromProcess(_InLoop):
 
     TOP_UP = 16
 
-    def __init__(self, controller: Controller, setpoints: Iterable[SetPoint], testbed: Testbed) -> None:
+    def __init__(self, controller: Controller, setpoints: Iterable[SetPoint], testbed: Testbed,
+                 insertion_mm: float) -> None:
         super().__init__(controller, setpoints)
         self._testbed = testbed
-        self._process = CommandProcess(controller, testbed.positions().insertion_mm)
+        self._process = CommandProcess(controller, insertion_mm)
         self._queued: deque[SetPoint] = deque()
         self.held_cycles = 0
         try:
             self._top_up()
-            self._hold_until_ready(len(self._queued))
+            self._hold_until(len(self._queued))
         except BaseException:
             self._process.close()
             raise
@@ -199,7 +204,7 @@ class _FromProcess(_InLoop):
         self._process.submit(fresh)
         self._queued.extend(fresh)
 
-    def _hold_until_ready(self, count: int) -> int:
+    def _hold_until(self, count: int) -> int:
         """Hold the testbed until `count` commands are back (or an error ends the answers); the cycles held."""
         held = 0
         while self._process.ready() < count and not self._process.stopped_at_error:
@@ -207,8 +212,10 @@ class _FromProcess(_InLoop):
             held += 1
         return held
 
+    def hold_until_ready(self) -> None:
+        self.held_cycles += self._hold_until(1)
+
     def command(self, setpoint: SetPoint, measurement, tension_n) -> TendonCommand:
-        self.held_cycles += self._hold_until_ready(1)
         return self._process.next_command()
 
     def close(self) -> None:
