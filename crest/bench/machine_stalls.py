@@ -8,20 +8,28 @@ just before (`machine_floor`). It runs alone, not beside the stack: a process wa
 millisecond at a priority above the stack's threads would take its own share of their CPUs.
 
 The probe is a process of its own that does nothing but sleep to absolute deadlines every
-`period_s`, under SCHED_FIFO at `priority` (nothing of lower priority can run in its way). Each
-wake-up later than STALL_THRESHOLD_S is a stall of the machine: the interval [wake - lateness,
-wake]. It reads stdin and stops when stdin closes (also when its parent dies), then prints its
-report as one JSON line.
+`period_s`, under SCHED_FIFO at `priority` (nothing of lower priority can run in its way), on one
+CPU. Each wake-up later than STALL_THRESHOLD_S is a stall of the machine: the interval [wake -
+lateness, wake]. It reads stdin and stops when stdin closes (also when its parent dies), then
+prints its report as one JSON line.
 
-    python -m crest.bench.machine_stalls PERIOD_S PRIORITY
+    python -m crest.bench.machine_stalls PERIOD_S PRIORITY CPU      (CPU -1: not pinned)
+
+A virtual CPU stalls on its own as well as with the whole machine (on this project's 2-CPU
+machine, 2026-11-27: two probes pinned apart for 90 s, twice, saw 1 and 4 stalls on one CPU alone
+and 1 on both at once). The full stack uses every CPU (the master on one, the served testbed on
+another, crest.testbed_service.cpu_split), and a stall of either delays its SYNC, so its floor is
+`machine_floor`: one probe pinned to each CPU, all at once, and the union of their stalls.
 """
 from __future__ import annotations
 
 import json
+import os
 import select
 import subprocess
 import sys
 import time
+from contextlib import ExitStack
 from dataclasses import dataclass
 
 from crest.driver.realtime_scheduling import realtime_threads
@@ -34,12 +42,13 @@ READY = "ready"
 
 @dataclass(frozen=True)
 class StallReport:
-    """What the probe saw: its scheduling, its wake-ups, and each stall (a wake-up more than
-    STALL_THRESHOLD_S late) as (start_s, end_s) on time.time()'s clock."""
+    """What the probe saw: its scheduling, its wake-ups, each stall (a wake-up more than
+    STALL_THRESHOLD_S late) as (start_s, end_s) on time.time()'s clock, and the CPUs it ran on."""
 
     scheduling: str
     wakeups: int
     stalls: tuple[tuple[float, float], ...]
+    cpus: tuple[int, ...] = ()
 
     @property
     def longest_ms(self) -> float:
@@ -54,15 +63,17 @@ class StallReport:
 class MachineStallProbe:
     """The probe process, for a `with` block: `report` holds what it saw once the block ends."""
 
-    def __init__(self, priority: int = PROBE_PRIORITY, period_s: float = PROBE_PERIOD_S):
+    def __init__(self, priority: int = PROBE_PRIORITY, period_s: float = PROBE_PERIOD_S, cpu: int | None = None):
         self.priority = priority
         self.period_s = period_s
+        self.cpu = cpu
         self.report: StallReport | None = None
         self._process: subprocess.Popen | None = None
 
     def __enter__(self) -> "MachineStallProbe":
         self._process = subprocess.Popen(
-            [sys.executable, "-m", "crest.bench.machine_stalls", repr(self.period_s), str(self.priority)],
+            [sys.executable, "-m", "crest.bench.machine_stalls", repr(self.period_s), str(self.priority),
+             str(-1 if self.cpu is None else self.cpu)],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
         first = self._process.stdout.readline().strip()
         if first != READY:
@@ -84,26 +95,61 @@ class MachineStallProbe:
                 self._process.wait()
 
 
-def machine_floor(duration_s: float, priority: int = PROBE_PRIORITY) -> StallReport:
-    """The probe alone for `duration_s`: the stalls of the machine as it is now."""
-    with MachineStallProbe(priority) as probe:
+@dataclass(frozen=True)
+class MachineFloor:
+    """The stalls of every CPU, probed at the same time: `per_cpu` maps a CPU to its probe's report."""
+
+    per_cpu: dict[int, StallReport]
+
+    @property
+    def any_cpu(self) -> StallReport:
+        """The union of the CPUs' stalls (overlapping intervals merged into one): what delays a
+        program that needs every CPU."""
+        merged: list[tuple[float, float]] = []
+        for start, end in sorted(s for report in self.per_cpu.values() for s in report.stalls):
+            if merged and start <= merged[-1][1]:
+                merged[-1] = (merged[-1][0], max(merged[-1][1], end))
+            else:
+                merged.append((start, end))
+        first = next(iter(self.per_cpu.values()))
+        return StallReport(first.scheduling, sum(r.wakeups for r in self.per_cpu.values()), tuple(merged),
+                           tuple(sorted(cpu for report in self.per_cpu.values() for cpu in report.cpus)))
+
+    def on_every_cpu(self, duration_s: float) -> int:
+        """How many stalls longer than `duration_s` overlap a stall of every other CPU: the whole
+        machine paused at once."""
+        reports = list(self.per_cpu.values())
+        return sum(all(any(s < end and start < e for s, e in other.stalls) for other in reports[1:])
+                   for start, end in reports[0].stalls if end - start > duration_s)
+
+
+def machine_floor(duration_s: float, priority: int = PROBE_PRIORITY) -> MachineFloor:
+    """One probe pinned to each CPU this process may use, all for the same `duration_s`: the
+    stalls of the machine as it is now."""
+    cpus = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else [None]
+    with ExitStack() as stack:
+        probes = {cpu: stack.enter_context(MachineStallProbe(priority, cpu=cpu)) for cpu in cpus}
         time.sleep(duration_s)
-    return probe.report
+    return MachineFloor({(-1 if cpu is None else cpu): probe.report for cpu, probe in probes.items()})
 
 
 def parse_report(line: str) -> StallReport:
     raw = json.loads(line)
     return StallReport(scheduling=raw["scheduling"], wakeups=int(raw["wakeups"]),
-                       stalls=tuple((float(start), float(end)) for start, end in raw["stalls"]))
+                       stalls=tuple((float(start), float(end)) for start, end in raw["stalls"]),
+                       cpus=tuple(int(cpu) for cpu in raw["cpus"]))
 
 
-def probe(period_s: float, priority: int) -> dict:
-    """Wake every `period_s` until stdin closes; the report as a dict (see the module doc).
+def probe(period_s: float, priority: int, cpu: int | None = None) -> dict:
+    """Wake every `period_s` on `cpu` (None: wherever the scheduler puts it) until stdin closes;
+    the report as a dict (see the module doc).
 
     The k-th deadline is start + k period (absolute, so a late wake-up does not shift the later
     ones); a wake-up `late` seconds after its deadline records the stall [now - late, now].
     """
     stalls, wakeups = [], 0
+    if cpu is not None:
+        os.sched_setaffinity(0, {cpu})
     with realtime_threads(priority) as scheduling:
         print(READY, flush=True)
         start = time.monotonic()
@@ -120,8 +166,10 @@ def probe(period_s: float, priority: int) -> dict:
                 now_s = time.time()
                 stalls.append((now_s - late_s, now_s))
             deadline += period_s * (1 + int(late_s // period_s))   # the next deadline still ahead
-    return {"scheduling": scheduling.describe(), "wakeups": wakeups, "stalls": stalls}
+    return {"scheduling": scheduling.describe(), "wakeups": wakeups, "stalls": stalls,
+            "cpus": sorted(os.sched_getaffinity(0))}
 
 
 if __name__ == "__main__":
-    print(json.dumps(probe(float(sys.argv[1]), int(sys.argv[2]))), flush=True)
+    pinned_cpu = int(sys.argv[3])
+    print(json.dumps(probe(float(sys.argv[1]), int(sys.argv[2]), None if pinned_cpu < 0 else pinned_cpu)), flush=True)

@@ -1,11 +1,14 @@
 """Recording one experiment: the crest log (CSV + sidecar) and the CAN traffic beside it.
 
 A row's tip is the tip of a tracker frame that arrived since the row before, or empty (see
-tip_feed). The log is closed with the stop cause when a safety stop happens, so a stopped run
-leaves a complete, readable log; every close adds the tip coverage (rows with and without a tip,
-when the tracker was lost: tip_coverage) and, per axis, the rows in which the drive's answer to
-that SYNC did not come (drive_feedback_coverage) to the sidecar's summary. A stop after the log
-was closed (at the end of the session) still puts its cause into the sidecar.
+tip_feed). A row's positions and forces are the drives' answers to that row's SYNC: an axis whose
+answer did not come (CycleSample.fresh False) has an empty position cell, and a tendon also an
+empty force cell (`measured_answers`), never its last known values again. The log is closed
+with the stop cause when a safety stop happens, so a stopped run leaves a complete, readable log;
+every close adds the tip coverage (rows with and without a tip, when the tracker was lost:
+tip_coverage) and, per axis, the number of rows in which the drive's answer to that SYNC did not
+come, the rows with that axis' cells empty (drive_feedback_coverage), to the sidecar's summary. A
+stop after the log was closed (at the end of the session) still puts its cause into the sidecar.
 """
 from __future__ import annotations
 
@@ -22,6 +25,15 @@ from crest.log import BusRecorder, LogWriter
 from crest.log.log_format import catheter_dict
 from crest.session import Session
 from model import CatheterParams
+
+
+def measured_answers(sample: CycleSample) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """(position_mm, tension_n) in AXIS_ORDER (tendon1..tendon4, insertion), as the log holds them:
+    an axis whose answer to this SYNC did not come (``fresh`` False) is NaN in both (its last known
+    values are not this SYNC's measurement)."""
+    def measured(values: tuple[float, ...]) -> tuple[float, ...]:
+        return tuple(value if fresh else float("nan") for value, fresh in zip(values, sample.fresh, strict=True))
+    return measured(sample.position_mm), measured(sample.tension_n)
 
 
 class ExperimentRecorder:
@@ -64,9 +76,9 @@ class ExperimentRecorder:
         if self._t0_s is None:
             self._t0_s = sample.t_s
         t_s = sample.t_s - self._t0_s
+        position_mm, tension_n = measured_answers(sample)
         self.writer.write(t_s, sample.tendon_target_mm, sample.insertion_target_mm,
-                          sample.tendon_position_mm, sample.insertion_position_mm, tip_mm,
-                          tendon_force_n=sample.tendon_tension_n, tip_ref_mm=tip_ref_mm)
+                          position_mm[:4], position_mm[4], tip_mm, tendon_force_n=tension_n[:4], tip_ref_mm=tip_ref_mm)
         self.tip_coverage.add(sample.t_s, tip_mm is not None and bool(np.isfinite(tip_mm).all()))
         self.feedback_coverage.add(t_s, sample.fresh)
 

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from crest.log import ExperimentLog, read_log
+from crest.log.missing_positions import filled_positions_mm
 from model.gap.recording import Recording, RecordingError
 
 MODEL_TENDON_ANGLES_DEG = (0.0, 90.0, 180.0, 270.0)
@@ -15,6 +16,9 @@ MODEL_TENDON_ANGLES_DEG = (0.0, 90.0, 180.0, 270.0)
 def recording_from_log(log: ExperimentLog) -> Recording:
     """The log's measured positions, tips, forces and catheter geometry as a Recording.
 
+    The positions drive the model, so an axis' empty position cells (its drive did not answer
+    that SYNC) are filled from its measured rows (`filled_positions_mm`); an axis with no measured
+    row is refused (LogFormatError). Forces stay NaN where the log has none.
     The model's tendons sit at 0, 90, 180, 270 deg; a log with other tendon angles is refused.
     A row whose tip repeats the previous row's exactly holds the tracker's last frame (the log
     runs at the SYNC rate, the tracker slower): it is not a measurement and counts as missing.
@@ -26,8 +30,9 @@ def recording_from_log(log: ExperimentLog) -> Recording:
                              "columns when importing)")
     tip = np.array(log.tip_mm, dtype=float)
     tip[1:][np.all(tip[1:] == tip[:-1], axis=1)] = np.nan
-    return Recording(name=Path(log.path).name, t_s=np.asarray(log.t_s), tendon_mm=np.asarray(log.tendon_pos_mm),
-                     insertion_mm=np.asarray(log.insertion_pos_mm), tip_mm=tip,
+    tendon_mm, insertion_mm = filled_positions_mm(log)
+    return Recording(name=Path(log.path).name, t_s=np.asarray(log.t_s), tendon_mm=tendon_mm,
+                     insertion_mm=insertion_mm, tip_mm=tip,
                      tendon_force_n=None if log.tendon_force_n is None else np.asarray(log.tendon_force_n),
                      flexible_length_mm=float(log.catheter["flexible_length_mm"]),
                      tendon_offset_mm=float(log.catheter["tendon_offset_mm"]),

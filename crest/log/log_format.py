@@ -14,11 +14,18 @@ Conventions:
 - insertion is the free length extended from the tube.
 - The tip is in the base frame: origin at the centre of the tube exit, z out of the tube,
   x toward tendon 1.
+- A row holds only what was measured at its time; an empty cell is a value not measured then.
 - A missing tracker sample is an empty cell (tip_x, tip_y, tip_z all empty). A row's tip comes
   from a tracker frame that arrived since the row before: a log written faster than the tracker
-  has empty tips between frames, never the previous frame again. Empty cells are
-  allowed only in the tip, tip_ref and tendon_force columns; t, commands and positions are always
-  finite numbers. Numbers are plain decimals (``nan``/``inf`` text is refused).
+  has empty tips between frames, never the previous frame again.
+- An empty position cell (tendon_pos_k or insertion_pos, each on its own) means that the drive's
+  answer to this row's SYNC did not come: the row holds no position of that axis, never an
+  earlier answer again. An empty tendon_pos_k goes with an empty tendon_force_k when the
+  tendon_force group is present (the force comes in the same answer); a tendon_force_k cell may
+  also be empty on its own (no force measured). Logs whose positions are all numbers stay valid.
+- Empty cells are allowed only in the position, tip, tip_ref and tendon_force columns; t and the
+  commands (tendon_cmd_k, insertion_cmd) are always finite numbers. Numbers are plain decimals
+  (``nan``/``inf`` text is refused).
 - The writer writes whole lines; a last line without its ``\\n`` is the partial write of a killed
   writer, and the reader drops it with a `TruncatedLogWarning`.
 
@@ -56,8 +63,7 @@ REQUIRED_COLUMNS = ((TIME_COLUMN,) + TENDON_CMD_COLUMNS + (INSERTION_CMD_COLUMN,
                     + (INSERTION_POS_COLUMN,) + TIP_COLUMNS)
 OPTIONAL_COLUMN_GROUPS = {"tendon_force": TENDON_FORCE_COLUMNS, "tip_ref": TIP_REF_COLUMNS}
 # Columns that must hold a finite number on every row; the others may be empty (missing).
-FINITE_COLUMNS = ((TIME_COLUMN,) + TENDON_CMD_COLUMNS + (INSERTION_CMD_COLUMN,) + TENDON_POS_COLUMNS
-                  + (INSERTION_POS_COLUMN,))
+FINITE_COLUMNS = (TIME_COLUMN,) + TENDON_CMD_COLUMNS + (INSERTION_CMD_COLUMN,)
 
 COLUMN_UNITS = {TIME_COLUMN: "s",
                 **{name: "mm" for name in TENDON_CMD_COLUMNS + (INSERTION_CMD_COLUMN,) + TENDON_POS_COLUMNS

@@ -38,8 +38,11 @@ _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 class ExperimentLog:
     """One experiment log as read-only arrays over T samples (units: s, mm, N).
 
-    ``tip_mm`` is NaN on rows where the tracker sample is missing; ``tendon_force_n`` and
-    ``tip_ref_mm`` are None when the log has no such columns (NaN where a cell is empty).
+    ``tip_mm`` is NaN on rows where the tracker sample is missing; ``tendon_pos_mm`` and
+    ``insertion_pos_mm`` are NaN where that axis' drive did not answer the row's SYNC (an empty
+    cell; `missing_positions.filled_positions_mm` gives model inputs without gaps);
+    ``tendon_force_n`` and ``tip_ref_mm`` are None when the log has no such columns (NaN where a
+    cell is empty). t and the commands are finite on every row.
     ``sidecar`` is the whole JSON sidecar (units per column, config snapshot, software version,
     summary, ...).
     """
@@ -157,6 +160,10 @@ def _read_rows(path: Path) -> tuple[list[str], list[list[float]]]:
     finite_positions = [columns.index(name) for name in FINITE_COLUMNS]
     groups = [[columns.index(name) for name in names]
               for names in (TIP_COLUMNS, TIP_REF_COLUMNS) if names[0] in columns]
+    # (tendon_pos_k, tendon_force_k): both come in one drive answer, so an empty position needs an empty force.
+    answers = ([(columns.index(pos), columns.index(force))
+                for pos, force in zip(TENDON_POS_COLUMNS, TENDON_FORCE_COLUMNS)]
+               if TENDON_FORCE_COLUMNS[0] in columns else [])
 
     rows = []
     previous_t_s = -math.inf
@@ -176,8 +183,14 @@ def _read_rows(path: Path) -> tuple[list[str], list[list[float]]]:
                                      line=number, column=name)
         for position in finite_positions:
             if not math.isfinite(values[position]):
-                raise LogFormatError(path, "empty; this column must hold a number on every row", line=number,
+                raise LogFormatError(path, "empty; this column must hold a number on every row (only position, "
+                                           "tip, tip_ref and tendon_force cells may be empty)", line=number,
                                      column=columns[position])
+        for position, force in answers:
+            if math.isnan(values[position]) and not math.isnan(values[force]):
+                raise LogFormatError(path, f"{columns[position]} is empty (the drive's answer to this SYNC did not "
+                                           f"come) but {columns[force]} holds a number; leave both empty",
+                                     line=number, column=columns[force])
         for positions in groups:
             missing = [math.isnan(values[position]) for position in positions]
             if any(missing) and not all(missing):

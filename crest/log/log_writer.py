@@ -24,6 +24,8 @@ from typing import Any
 
 from crest.log.log_format import (
     FORMAT_TAG,
+    INSERTION_CMD_COLUMN,
+    INSERTION_POS_COLUMN,
     TENDON_CMD_COLUMNS,
     TENDON_FORCE_COLUMNS,
     TENDON_POS_COLUMNS,
@@ -120,23 +122,37 @@ class LogWriter:
         return self._rows_written
 
     def write(self, t_s: float, tendon_cmd_mm: Sequence[float], insertion_cmd_mm: float,
-              tendon_pos_mm: Sequence[float], insertion_pos_mm: float, tip_mm: Sequence[float] | None = None,
-              *, tendon_force_n: Sequence[float] | None = None, tip_ref_mm: Sequence[float] | None = None) -> None:
+              tendon_pos_mm: Sequence[float | None], insertion_pos_mm: float | None,
+              tip_mm: Sequence[float] | None = None, *, tendon_force_n: Sequence[float | None] | None = None,
+              tip_ref_mm: Sequence[float] | None = None) -> None:
         """Append one sample. ``tip_mm`` None (or all NaN) is a missing tracker sample.
 
-        t must increase strictly; commands and positions must be finite (ValueError otherwise).
+        A position entry (one of ``tendon_pos_mm``, or ``insertion_pos_mm``) that is None or NaN is
+        an axis whose drive did not answer this SYNC: an empty cell. A ``tendon_force_n`` entry
+        None or NaN is an empty force cell (all four when ``tendon_force_n`` is None), and a tendon
+        without a position must have none. t must increase strictly; t and commands must be finite,
+        and positions and forces finite or missing, never infinite (ValueError otherwise).
         """
         t_s = float(t_s)
         if not math.isfinite(t_s):
             raise ValueError(f"{self.path}: t must be finite, got {t_s!r}")
         cells = [_number(t_s)]
         cells += _finite_cells(tendon_cmd_mm, TENDON_CMD_COLUMNS, self.path)
-        cells += _finite_cells([insertion_cmd_mm], ("insertion_cmd",), self.path)
-        cells += _finite_cells(tendon_pos_mm, TENDON_POS_COLUMNS, self.path)
-        cells += _finite_cells([insertion_pos_mm], ("insertion_pos",), self.path)
+        cells += _finite_cells([insertion_cmd_mm], (INSERTION_CMD_COLUMN,), self.path)
+        tendon_pos_cells = _measured_cells(tendon_pos_mm, TENDON_POS_COLUMNS, self.path)
+        cells += tendon_pos_cells
+        cells += _measured_cells([insertion_pos_mm], (INSERTION_POS_COLUMN,), self.path)
         cells += _optional_cells(tip_mm, TIP_COLUMNS, self.path)
         if self._tendon_force:
-            cells += _optional_cells(tendon_force_n, TENDON_FORCE_COLUMNS, self.path)
+            force_cells = (_measured_cells(tendon_force_n, TENDON_FORCE_COLUMNS, self.path)
+                           if tendon_force_n is not None else [""] * len(TENDON_FORCE_COLUMNS))
+            for position, force, pos_column, force_column in zip(tendon_pos_cells, force_cells, TENDON_POS_COLUMNS,
+                                                                 TENDON_FORCE_COLUMNS):
+                if position == "" and force != "":
+                    raise ValueError(f"{self.path}: {pos_column} is missing (no answer from the drive) but "
+                                     f"{force_column} is {force}; a tendon's force comes in the same answer, "
+                                     "so give NaN for both")
+            cells += force_cells
         elif tendon_force_n is not None:
             raise ValueError(f"{self.path}: tendon_force_n given but the log was opened without tendon_force=True")
         if self._tip_ref:
@@ -237,6 +253,21 @@ def _finite_cells(values: Sequence[float] | Any, columns: Sequence[str], path: P
         if not math.isfinite(value):
             raise ValueError(f"{path}: {column} must be a finite number, got {value!r}")
     return [_number(value) for value in cells]
+
+
+def _measured_cells(values: Sequence[float | None], columns: Sequence[str], path: Path) -> list[str]:
+    """One cell per value: empty where it was not measured (None or NaN), else the finite number."""
+    values = list(values)
+    if len(values) != len(columns):
+        raise ValueError(f"{path}: expected {len(columns)} values for {', '.join(columns)}, got {len(values)}")
+    cells = []
+    for value, column in zip(values, columns):
+        value = math.nan if value is None else float(value)
+        if math.isinf(value):
+            raise ValueError(f"{path}: {column} must be a finite number, or NaN/None when not measured; "
+                             f"got {value!r}")
+        cells.append("" if math.isnan(value) else _number(value))
+    return cells
 
 
 def _optional_cells(values: Sequence[float] | None, columns: Sequence[str], path: Path) -> list[str]:

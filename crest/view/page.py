@@ -9,6 +9,7 @@ The page only draws: what to show is decided by live_state.py or replay_state.py
 from __future__ import annotations
 
 import html
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -130,10 +131,15 @@ def _xyz(points: np.ndarray) -> dict[str, np.ndarray]:
     return {axis: points[:, index] for axis, index in AXIS_INDEX.items()}
 
 
+def _position_text(position_mm: float) -> str:
+    """The table's position cell: mm with 3 decimals, or "no answer" (NaN: the drive did not answer)."""
+    return "no answer" if math.isnan(position_mm) else f"{position_mm:.3f}"
+
+
 def _axis_table(frame: ViewFrame) -> str:
     cells = "".join(
         f"<tr><td>{html.escape(row.axis)}</td><td>{html.escape(row.state or 'not logged')}</td>"
-        f"<td style='text-align:right'>{row.position_mm:.3f}</td><td style='text-align:right'>"
+        f"<td style='text-align:right'>{_position_text(row.position_mm)}</td><td style='text-align:right'>"
         f"{'' if row.following_error_mm is None else f'{row.following_error_mm:+.3f}'}</td></tr>"
         for row in frame.axes)
     return ("<table style='border-collapse:collapse' cellpadding='4' border='1'><tr><th>axis</th>"

@@ -1,7 +1,10 @@
 """A recorded log as view frames: the screen at any time of the log, for `crest view LOG.csv`.
 
 The log holds what was measured (set-points, positions, tensions, tip) but not the CiA 402
-states, so the axis table says "not logged" there. The stop, if the run ended in one, comes from
+states, so the axis table says "not logged" there. A row without an axis' position (its drive did
+not answer that SYNC: an empty cell) shows no position for that axis in the table; the backbone,
+which the model draws from all five positions, uses that axis' position filled from its measured
+rows (`missing_positions.filled_positions_mm`). The stop, if the run ended in one, comes from
 the sidecar's summary (``stop_cause``, ``exit_code``) and is shown at the log's last row.
 """
 from __future__ import annotations
@@ -12,6 +15,7 @@ import numpy as np
 
 from crest.driver import AXIS_ORDER
 from crest.log.log_reader import ExperimentLog, read_log
+from crest.log.missing_positions import filled_positions_mm
 from crest.view.model_backbone import ModelBackbone
 from crest.view.view_frame import AxisRow, StopReport, ViewFrame
 
@@ -26,12 +30,13 @@ class ReplayState:
         if len(self.log) == 0:
             raise ValueError(f"{path}: the log has no rows to replay")
         self._backbone = ModelBackbone(float(self.log.catheter["tendon_offset_mm"]))
-        axes = {axis["name"]: axis for axis in self.log.sidecar.get("config", {}).get("axes", [])
+        axes = {axis["name"]: axis for axis in (self.log.sidecar.get("config") or {}).get("axes", [])
                 if isinstance(axis, dict) and "name" in axis}
         limits = [axes[name]["max_tension_n"] for name in AXIS_ORDER[:4] if "max_tension_n" in axes.get(name, {})]
         self.max_tension_n = float(min(limits)) if limits else float("nan")
         self.extent_mm = float(self.log.catheter.get("flexible_length_mm", np.nanmax(self.log.insertion_pos_mm)))
         self._positions = np.column_stack([self.log.tendon_pos_mm, self.log.insertion_pos_mm])
+        self._backbone_tendon_mm, self._backbone_insertion_mm = filled_positions_mm(self.log)
         self._commands = np.column_stack([self.log.tendon_cmd_mm, self.log.insertion_cmd_mm])
         valid_ref = self.log.tip_ref_mm is not None
         self._reference = self.log.tip_ref_mm[np.all(np.isfinite(self.log.tip_ref_mm), axis=1)] if valid_ref \
@@ -67,12 +72,13 @@ class ReplayState:
         if tip is not None and log.tip_ref_mm is not None and np.all(np.isfinite(log.tip_ref_mm[i])):
             tip_error = float(np.linalg.norm(tip - log.tip_ref_mm[i]))
         axes = tuple(AxisRow(name, "", float(self._positions[i, k]),
-                             float(self._commands[i - 1, k] - self._positions[i, k]) if i > 0 else None)
+                             float(self._commands[i - 1, k] - self._positions[i, k])
+                             if i > 0 and np.isfinite(self._positions[i, k]) else None)
                      for k, name in enumerate(AXIS_ORDER))
         notes = () if log.tendon_force_n is not None else ("this log has no tendon tension columns",)
         return ViewFrame(
             t_s=float(log.t_s[i]),
-            backbone_mm=self._backbone.points_mm(log.tendon_pos_mm[i], log.insertion_pos_mm[i]),
+            backbone_mm=self._backbone.points_mm(self._backbone_tendon_mm[i], self._backbone_insertion_mm[i]),
             tip_mm=tip, trail_mm=log.tip_mm[recent], reference_mm=self._reference,
             tension_t_s=log.t_s[window] if log.tendon_force_n is not None else np.empty(0),
             tension_n=tensions, max_tension_n=self.max_tension_n, axes=axes,

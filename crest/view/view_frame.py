@@ -15,6 +15,9 @@ import numpy as np
 class AxisRow:
     """One axis: its CiA 402 state ('' when not known, e.g. in a log), position and following error.
 
+    ``position_mm`` is NaN when the drive's answer to this SYNC did not come (an empty log cell);
+    the following error is then None.
+
     ``following_error_mm`` is the set-point latched one SYNC earlier minus the position actual
     sampled at this SYNC (the host's following-error check, feedback_checks.py); during a
     profile-position move (homing, a point move) the set-point is the move's goal.

@@ -139,7 +139,7 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
 
     zeros = baseline.zero_offsets_mm
     tensions = [predict_tips_and_tension(baseline.params, baseline.terms(), np.asarray(zeros), r, res)[1]
-                if r.tendon_force_n is None else None for r in held]
+                if r.tendon_force_n is None or not np.isfinite(r.tendon_force_n).all() else None for r in held]
     features = compute_features(held, zeros, tensions)
     chosen_features = features.subset(split.selection_mask)
 

@@ -22,6 +22,8 @@ class Recording:
 
     tendon_mm: [T, 4] measured tendon displacements for tendons at 0, 90, 180, 270 deg.
     insertion_mm: [T] measured free length out of the support tube.
+    Both drive the model and must be finite on every sample (a loader fills a sample whose position
+    was not measured before building the recording).
     tip_mm: [T, 3] measured tip in the base frame; NaN rows are missing tracker samples.
     tendon_force_n: [T, 4] measured tendon tension, or None when the log has none.
     flexible_length_mm, tendon_offset_mm, outer_diameter_mm: the catheter's geometry
@@ -51,6 +53,13 @@ class Recording:
             raise RecordingError(f"{self.name}: {n} samples; a recording needs at least 3")
         if not np.all(np.diff(self.t_s) > 0):
             raise RecordingError(f"{self.name}: t_s must increase strictly")
+        for field in ("tendon_mm", "insertion_mm"):
+            finite = np.isfinite(getattr(self, field))
+            if not finite.all():
+                sample = int(np.argmin(finite.reshape(n, -1).all(axis=1)))
+                raise RecordingError(f"{self.name}: {field} is not finite at sample {sample} (t = "
+                                     f"{float(self.t_s[sample]):g} s); the positions drive the model, so fill "
+                                     "samples without a measured position before building the recording")
         if not self.valid.any():
             raise RecordingError(f"{self.name}: no tip sample is present; the gap needs measured tips")
 

@@ -47,8 +47,10 @@ class SampleFeatures:
 
 
 def compute_features(recordings: Sequence[Recording], zero_offsets_mm: Sequence[float],
-                     modelled_tension_n: Sequence[np.ndarray]) -> SampleFeatures:
-    """Features of the valid samples. Tension: the log's tendon forces where present, else the model's."""
+                     modelled_tension_n: Sequence[np.ndarray | None]) -> SampleFeatures:
+    """Features of the valid samples. Tension: the log's tendon forces where measured, else (a log
+    without forces, or a cell a drive did not answer) the model's; a recording's modelled tension
+    [T, 4] is None where every force was measured."""
     parts = []
     for index, (r, model_tension) in enumerate(zip(recordings, modelled_tension_n)):
         u = r.tendon_mm - np.asarray(zero_offsets_mm)
@@ -59,9 +61,10 @@ def compute_features(recordings: Sequence[Recording], zero_offsets_mm: Sequence[
         insertion_rate = np.abs(np.gradient(r.insertion_mm, r.t_s))
         theta_rate = np.gradient(theta_deg, r.t_s)
         motion = _motion(bend, theta_rate, speed, insertion_rate, r.t_s)
-        force = r.tendon_force_n if r.tendon_force_n is not None and np.isfinite(r.tendon_force_n).any() \
-            else model_tension
-        tension = np.nansum(np.clip(force, 0.0, None), axis=1)
+        force = r.tendon_force_n if model_tension is None else (
+            model_tension if r.tendon_force_n is None
+            else np.where(np.isfinite(r.tendon_force_n), r.tendon_force_n, model_tension))  # unmeasured: the model's
+        tension = np.sum(np.clip(force, 0.0, None), axis=1)
         fraction = (r.t_s - r.t_s[0]) / max(r.t_s[-1] - r.t_s[0], 1e-12)
         valid = r.valid
         parts.append((theta_deg[valid], plane_deg[valid], r.insertion_mm[valid], motion[valid], speed[valid],

@@ -57,7 +57,7 @@ def test_jog_pulling_one_tendon_pays_out_its_partner_and_stops_short_of_the_tens
         close_terminal(master, process)
     assert b"tension limit: tendon1" in out
     log = read_log(tmp_path / "jog.csv")
-    assert log.tendon_force_n.max() < 40.0                               # never near the safety stop
+    assert np.nanmax(log.tendon_force_n) < 40.0      # never near the safety stop (NaN: a drive did not answer)
     pulled = log.tendon_cmd_mm[-1, 0] - log.tendon_cmd_mm[0, 0]
     assert pulled > 1.0
     assert log.tendon_cmd_mm[-1, 2] - log.tendon_cmd_mm[0, 2] == pytest.approx(-pulled, abs=1e-3)   # partner paid out

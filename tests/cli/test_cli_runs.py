@@ -6,9 +6,11 @@ import time
 import warnings
 
 import can
+import numpy as np
 import pytest
 
 from cli_runner import crest, start_crest
+from crest.driver import AXIS_ORDER
 from crest.exit_codes import ExitCode
 from crest.log import read_log
 from crest.log.log_format import TruncatedLogWarning
@@ -36,6 +38,7 @@ def test_demo_boots_homes_runs_the_paper_circle_and_records(tmp_path):
 @pytest.mark.parametrize("fault,code,axis", [
     ("tendon3:emcy@3.0", ExitCode.EMCY, "tendon3"),
     ("insertion:heartbeat@3.0", ExitCode.HEARTBEAT_LOST, "insertion"),
+    ("tendon2:heartbeat@3.0", ExitCode.HEARTBEAT_LOST, "tendon2"),      # a tendon: its force cells too
     ("tendon1:stall@1.5", ExitCode.FOLLOWING_ERROR, "tendon1"),   # jammed while pulling
 ])
 def test_a_drive_fault_stops_every_axis_with_its_exit_code_and_keeps_the_log(tmp_path, fault, code, axis):
@@ -50,10 +53,28 @@ def test_a_drive_fault_stops_every_axis_with_its_exit_code_and_keeps_the_log(tmp
     assert len(log) > 50
     sidecar = json.loads(log_path.with_suffix(".json").read_text())
     assert axis in sidecar["summary"]["stop_cause"]
-    if "heartbeat" in fault:     # the silent drive's rows repeat its last answer: the summary says which
-        stale = sidecar["summary"]["rows_with_stale_drive_feedback"]
-        assert stale.get(axis, 0) >= 1, stale
-        assert 2.95 <= sidecar["summary"]["first_stale_drive_feedback_s"][axis] <= 3.1   # at the fault (@3.0)
+    if "heartbeat" in fault:     # the silent drive's rows hold no answer of it: the summary counts them
+        unanswered = sidecar["summary"]["rows_without_drive_answer"]
+        assert unanswered.get(axis, 0) >= 1, unanswered
+        assert 2.95 <= sidecar["summary"]["first_row_without_drive_answer_s"][axis] <= 3.1   # at the fault (@3.0)
+        _assert_only_the_silent_drives_cells_are_empty(log, axis, unanswered[axis])
+
+
+def _assert_only_the_silent_drives_cells_are_empty(log, axis: str, rows: int) -> None:
+    """The silent axis' position (and a tendon's force) cells are empty in exactly ``rows`` rows, from
+    the fault (@3.0 s) on to the stop; in those rows every other axis' cells hold its answer."""
+    k = AXIS_ORDER.index(axis)
+    positions_mm = np.column_stack([log.tendon_pos_mm, log.insertion_pos_mm])
+    empty = np.isnan(positions_mm[:, k])
+    assert int(empty.sum()) == rows, (int(empty.sum()), rows)
+    first = int(np.argmax(empty))
+    assert 2.95 <= log.t_s[first] <= 3.1 and empty[first:].all(), log.t_s[empty]   # silent until the stop
+    assert np.isfinite(np.delete(positions_mm, k, axis=1)[empty]).all()
+    other_forces_n = log.tendon_force_n
+    if k < 4:
+        assert np.isnan(log.tendon_force_n[empty, k]).all() and np.isfinite(log.tendon_force_n[~empty, k]).all()
+        other_forces_n = np.delete(log.tendon_force_n, k, axis=1)
+    assert np.isfinite(other_forces_n[empty]).all()
 
 
 def test_fault_times_count_from_the_start_of_the_run(tmp_path):

@@ -1,5 +1,6 @@
 """Operator commands stay inside the tendon tension limit: the paper's scenarios run, and what would
 exceed max_tension_n (40 N) is refused before motion with the tension it needs (issue 15, items 7-8)."""
+import numpy as np
 import pytest
 
 from cli_runner import crest
@@ -17,8 +18,9 @@ def test_paper_scenarios_run_on_the_default_testbed_without_a_safety_stop(tmp_pa
     assert result.returncode == ExitCode.OK, result.stderr
     log = read_log(log_path)
     assert log.insertion_cmd_mm[0] == pytest.approx(80.0, abs=0.1)       # at the working free length
-    assert log.tendon_force_n.max() < MAX_TENSION_N
-    assert log.tendon_force_n.max() > 10.0                               # and the catheter was bent
+    measured_max_n = np.nanmax(log.tendon_force_n)      # over the drives' answers (NaN: an answer did not come)
+    assert measured_max_n < MAX_TENSION_N
+    assert measured_max_n > 10.0                                         # and the catheter was bent
 
 
 def test_move_that_needs_more_than_the_tension_limit_is_refused_before_motion(tmp_path):

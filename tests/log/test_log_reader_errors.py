@@ -1,6 +1,7 @@
 """The log reader refuses malformed logs with an error naming file, line and column."""
 
 import json
+import math
 from pathlib import Path
 
 import pytest
@@ -11,6 +12,7 @@ HEADER = ("t,tendon_cmd_1,tendon_cmd_2,tendon_cmd_3,tendon_cmd_4,insertion_cmd,"
           "tendon_pos_1,tendon_pos_2,tendon_pos_3,tendon_pos_4,insertion_pos,tip_x,tip_y,tip_z")
 ROW_0 = "0.0,1,0,-1,0,50,1,0,-1,0,50,0.5,0,49.9"
 ROW_1 = "0.01,1.5,0,-1.5,0,50,1.4,0,-1.4,0,50,0.8,0,49.8"
+FORCES = "tendon_force_1,tendon_force_2,tendon_force_3,tendon_force_4"
 SIDECAR = {"format": "crest-log/1",
            "catheter": catheter_dict(flexible_length_mm=80, tendon_offset_mm=2.5, outer_diameter_mm=6),
            "sample_rate_hz": 100.0, "source": "hand written", "notes": ""}
@@ -40,6 +42,11 @@ BAD_BODIES = [
     (f"{HEADER}\n{ROW_0}\n0.01,1,0,-1,0,50,1,0,-1,0,50,inf,0,50\n", 3, "tip_x", "not a finite number"),
     (f"{HEADER}\n{ROW_0}\n0.01,1,0,-1,0,50,1,0,-1,0,50,1e999,0,50\n", 3, "tip_x", "not a finite number"),
     (f"{HEADER}\n{ROW_0}\n0.01,1,,-1,0,50,1,0,-1,0,50,0,0,50\n", 3, "tendon_cmd_2", "must hold a number"),
+    (f"{HEADER}\n{ROW_0}\n0.01,1,0,-1,0,,1,0,-1,0,50,0,0,50\n", 3, "insertion_cmd", "must hold a number"),
+    (f"{HEADER}\n{ROW_0}\n,1,0,-1,0,50,1,0,-1,0,50,0,0,50\n", 3, "t", "must hold a number"),
+    (f"{HEADER}\n{ROW_0}\n0.01,1,0,-1,0,50,1,0,-1,0,inf,0,0,50\n", 3, "insertion_pos", "not a finite number"),
+    (f"{HEADER},{FORCES}\n{ROW_0},1,2,3,4\n0.01,1,0,-1,0,50,1,,-1,0,50,0,0,50,1,2,3,4\n", 3, "tendon_force_2",
+     "tendon_pos_2 is empty"),
     (f"{HEADER}\n{ROW_0}\n0.01,1,0,-1,0,50,1,0,-1,0,50,,0,50\n", 3, "tip_x", "all present or all empty"),
     (f"{HEADER}\n{ROW_1}\n{ROW_0}\n", 3, "t", "increase strictly"),
     (f"{HEADER}\n{ROW_0}\n{ROW_0}\n", 3, "t", "increase strictly"),
@@ -106,3 +113,16 @@ def test_partial_last_line_of_a_killed_writer_is_dropped_with_a_warning(tmp_path
 def test_header_only_log_is_an_empty_log(tmp_path: Path):
     log = read_log(_log(tmp_path, f"{HEADER}\n"))
     assert len(log) == 0 and log.tendon_cmd_mm.shape == (0, 4) and log.tip_mm.shape == (0, 3)
+
+
+def test_empty_position_cells_are_positions_not_measured(tmp_path: Path):
+    """An empty tendon_pos_k / insertion_pos is a drive that did not answer: NaN, with its force empty."""
+    body = (f"{HEADER},{FORCES}\n{ROW_0},1,2,3,4\n"
+            "0.01,1,0,-1,0,50,1,,-1,0,,0,0,50,1,,3,4\n"
+            "0.02,1,0,-1,0,50,,0,-1,0,50,,,,,2,3,\n")
+    log = read_log(_log(tmp_path, body))
+    assert log.tendon_pos_mm[1].tolist()[::2] == [1, -1] and math.isnan(log.tendon_pos_mm[1, 1])
+    assert math.isnan(log.insertion_pos_mm[1]) and log.insertion_pos_mm[2] == 50
+    assert math.isnan(log.tendon_pos_mm[2, 0]) and math.isnan(log.tendon_force_n[2, 0])
+    assert math.isnan(log.tendon_force_n[2, 3]) and log.tendon_pos_mm[2, 3] == 0   # a force may be missing alone
+    assert log.tendon_cmd_mm.tolist() == [[1, 0, -1, 0]] * 3

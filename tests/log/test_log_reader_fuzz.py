@@ -35,7 +35,11 @@ def _read(path: Path) -> ExperimentLog | None:
             assert str(path.parent) in str(error)
             return None
     assert np.all(np.diff(log.t_s) > 0)
-    assert np.all(np.isfinite(log.tendon_cmd_mm)) and np.all(np.isfinite(log.insertion_pos_mm))
+    assert np.all(np.isfinite(log.tendon_cmd_mm)) and np.all(np.isfinite(log.insertion_cmd_mm))
+    # a position is a number or empty (NaN: the drive did not answer), never infinite
+    assert not np.any(np.isinf(log.tendon_pos_mm)) and not np.any(np.isinf(log.insertion_pos_mm))
+    if log.tendon_force_n is not None:                        # no force without its position
+        assert np.all(np.isnan(log.tendon_force_n)[np.isnan(log.tendon_pos_mm)])
     return log
 
 

@@ -123,3 +123,33 @@ def test_unwritten_rows_never_span_more_than_the_flush_interval(tmp_path: Path):
             assert t_s - first_missing_t_s < 0.5
         assert len(path.read_text().splitlines()) < 301  # the last rows wait for the next flush ...
     assert len(read_log(path)) == 300  # ... and close writes them
+
+
+def test_a_position_the_drive_did_not_answer_is_an_empty_cell_read_back_as_nan(tmp_path: Path):
+    path = tmp_path / "silent.csv"
+    with _open(path, tendon_force=True) as writer:
+        writer.write(0.0, [1, 0, -1, 0], 50, [1.0, 0.5, -1.0, 0.0], 50.0, tendon_force_n=[2, 3, 4, 5])
+        writer.write(0.01, [1, 0, -1, 0], 50, [1.0, math.nan, -1.0, 0.0], None, tendon_force_n=[2, math.nan, 4, 5])
+        writer.write(0.02, [1, 0, -1, 0], 50, [None, 0.5, -1.0, 0.0], 50.1, tendon_force_n=[None, 3, 4, 5])
+    assert path.read_text().splitlines()[2].split(",")[6:11] == ["1.0", "", "-1.0", "0.0", ""]
+    log = read_log(path)
+    np.testing.assert_array_equal(log.tendon_pos_mm, [[1.0, 0.5, -1.0, 0.0], [1.0, np.nan, -1.0, 0.0],
+                                                      [np.nan, 0.5, -1.0, 0.0]])
+    np.testing.assert_array_equal(log.insertion_pos_mm, [50.0, np.nan, 50.1])
+    np.testing.assert_array_equal(log.tendon_force_n, [[2, 3, 4, 5], [2, np.nan, 4, 5], [np.nan, 3, 4, 5]])
+    np.testing.assert_array_equal(log.tendon_cmd_mm, [[1, 0, -1, 0]] * 3)   # commands stay numbers
+
+
+def test_writer_refuses_infinite_positions_and_a_force_without_its_position(tmp_path: Path):
+    with _open(tmp_path / "bad.csv", tendon_force=True) as writer:
+        with pytest.raises(ValueError, match="tendon_pos_2 must be a finite number, or NaN/None when not measured"):
+            writer.write(0.0, [0] * 4, 50, [0, math.inf, 0, 0], 50, tendon_force_n=[1] * 4)
+        with pytest.raises(ValueError, match="insertion_pos must be a finite number, or NaN/None"):
+            writer.write(0.0, [0] * 4, 50, [0] * 4, -math.inf, tendon_force_n=[1] * 4)
+        with pytest.raises(ValueError, match="tendon_pos_3 is missing .* but tendon_force_3 is 1.0"):
+            writer.write(0.0, [0] * 4, 50, [0, 0, math.nan, 0], 50, tendon_force_n=[1] * 4)
+        with pytest.raises(ValueError, match="insertion_cmd must be a finite number"):
+            writer.write(0.0, [0] * 4, math.nan, [0] * 4, 50, tendon_force_n=[1] * 4)
+        with pytest.raises(ValueError, match="t must be finite"):
+            writer.write(math.nan, [0] * 4, 50, [0] * 4, 50, tendon_force_n=[1] * 4)
+    assert len(read_log(tmp_path / "bad.csv")) == 0
