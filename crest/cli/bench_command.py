@@ -151,9 +151,12 @@ def format_table(results: dict) -> str:
                      f"{100 * r['bus_load_mean']:.0f}% of {r['bus_bitrate_bit_s'] / 1e6:g} Mbit/s"
                      + (f"; {r['cycles_held_for_a_command']} cycles held for a command not yet computed"
                         if r["cycles_held_for_a_command"] else "")
+                     + (f"; {r['cycles_without_every_answer']} cycles without every drive's answer in time"
+                        if r["cycles_without_every_answer"] is not None else "")
                      + (f"; stopped: {r['stopped']}" if r["stopped"] else ""),
-                     "rate held, 0 missed, p99 <= 1 ms",
-                     not r["stopped"] and r["missed_cycles"] == 0 and r["jitter_p99_ms"] <= 1.0))
+                     "rate held, 0 missed (SYNC late or an answer late), p99 <= 1 ms",
+                     not r["stopped"] and r["missed_cycles"] == 0 and r["cycles_without_every_answer"] == 0
+                     and r["jitter_p99_ms"] <= 1.0))
     notes = []
     for key, r in results.get("gap", {}).items():
         label = GAP_CASES[key]

@@ -48,7 +48,8 @@ class RunResult:
     set-points' tips, over the cycles with a tip (None without any). tip_coverage: the rows with a
     tip and the tracker loss, if any. command_process: the commands came from a CommandProcess;
     held_cycles: cycles in which the testbed held its commands because the process's next command
-    was not back yet (not counted in `cycles`, no row)."""
+    was not back yet (not counted in `cycles`, no row). unanswered_cycles: cycles in which at least
+    one drive's answer to the SYNC did not come in time (its row has that axis' cells empty)."""
 
     cycles: int
     tip_samples: int
@@ -58,6 +59,7 @@ class RunResult:
     tip_coverage: TipCoverage
     command_process: bool
     held_cycles: int
+    unanswered_cycles: int
 
 
 def run_with_controller(session: Session, setpoints: Iterable[SetPoint], controller: Controller, *,
@@ -82,7 +84,7 @@ def run_with_controller(session: Session, setpoints: Iterable[SetPoint], control
         testbed.watch_tracker(feed.age_s)
     squared_errors: list[float] = []
     tension_n = None
-    cycles = 0
+    cycles = unanswered_cycles = 0
     gc.freeze()
     try:
         session.start_fault_clock()
@@ -107,6 +109,7 @@ def run_with_controller(session: Session, setpoints: Iterable[SetPoint], control
             if tip is not None:
                 squared_errors.append(float(np.sum((tip - setpoint.tip_mm) ** 2)))
             cycles += 1
+            unanswered_cycles += not all(sample.fresh)
             if on_cycle is not None:
                 on_cycle(cycles)
             setpoint = next_setpoint
@@ -117,7 +120,7 @@ def run_with_controller(session: Session, setpoints: Iterable[SetPoint], control
             testbed.watch_tracker(None)
     rms = float(np.sqrt(np.mean(squared_errors))) if squared_errors else None
     return RunResult(cycles, len(squared_errors), feed.frames, rms, recorder.path if recorder else None,
-                     coverage, command_process, commands.held_cycles)
+                     coverage, command_process, commands.held_cycles, unanswered_cycles)
 
 
 def commands_in_own_process(session: Session, controller: Controller) -> bool:
