@@ -16,7 +16,7 @@ prints its report as one JSON line.
     python -m crest.bench.machine_stalls PERIOD_S PRIORITY CPU      (CPU -1: not pinned)
 
 A virtual CPU stalls on its own as well as with the whole machine (on this project's 2-CPU
-machine, 2026-11-27: two probes pinned apart for 90 s, twice, saw 1 and 4 stalls on one CPU alone
+machine, 2026-11-27: two probes pinned apart for 90 s, twice, saw 1 and 5 stalls on one CPU alone
 and 1 on both at once). The full stack uses every CPU (the master on one, the served testbed on
 another, crest.testbed_service.cpu_split), and a stall of either delays its SYNC, so its floor is
 `machine_floor`: one probe pinned to each CPU, all at once, and the union of their stalls.
