@@ -1,13 +1,17 @@
 """A drive whose answers to a few SYNCs never come (frames lost) does not stop a run: the run counts
 those cycles (RunResult.unanswered_cycles, printed by `crest run` and the bench), and each such
 row leaves that axis' cells empty (crest.experiment.recorder)."""
+from dataclasses import replace
+
 import numpy as np
 
 from control import Articulation, make_controller
 from crest.config import load_testbed_config
 from crest.experiment.builtin_trajectories import BuiltinOptions, builtin_trajectory
-from crest.experiment.controlled_run import run_with_controller
+from crest.cli.run_command import _report
+from crest.experiment.controlled_run import RunResult, run_with_controller
 from crest.experiment.recorder import ExperimentRecorder
+from crest.experiment.tip_coverage import TipCoverage
 from crest.experiment.workspace_from_config import limits_for, workspace_for
 from crest.log import read_log
 from crest.session import SessionOptions, open_session
@@ -49,3 +53,13 @@ def test_lost_answers_are_counted_and_their_cells_left_empty(tmp_path):
     assert len(LOST_SYNCS) <= result.unanswered_cycles <= len(LOST_SYNCS) + 1
     assert int(empty.sum()) == result.unanswered_cycles and result.cycles == len(log) == len(trajectory)
     assert np.isfinite(np.delete(log.tendon_pos_mm, 1, axis=1)).all() and np.isfinite(log.insertion_pos_mm).all()
+
+
+def test_crest_run_names_the_cycles_without_every_answer_in_its_summary_line(capsys):
+    result = RunResult(cycles=500, tip_samples=200, tracker_frames=200, rms_tip_error_mm=0.5, log_path=None,
+                       tip_coverage=TipCoverage(None), command_process=False, held_cycles=0, unanswered_cycles=4)
+    _report(result)
+    line = capsys.readouterr().out
+    assert line.startswith("ran 500 cycles; 4 cycles without every drive's answer in time")
+    _report(replace(result, unanswered_cycles=0))
+    assert "answer" not in capsys.readouterr().out
