@@ -11,7 +11,8 @@ the achieved rate, the period jitter (|period - nominal|, p50/p99), missed cycle
 longer than 1.5 nominal periods) and the bus load the traffic would put on a real bus. From the
 run itself: the cycles in which a drive's answer did not come before the next SYNC was due (the
 SYNC does not wait for it in real time, crest.driver.sync_cycle; that row lacks the answer), which
-the goal counts as missed too.
+the goal counts as missed too; and how long the drives' answers took after each SYNC, as the master
+saw them (crest.driver.answer_latency: p50, p99, p99.9, longest), where the cycle's time goes.
 """
 from __future__ import annotations
 
@@ -116,6 +117,7 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
         listener = SyncTimes()
         meter = BusLoadMeter(config.bus.bitrate, period_s)      # what the frames on the wire take
         notifier = can.Notifier(monitor, [listener, meter], timeout=0.1)
+        session.testbed.answer_latency.reset()
         try:
             result = run_with_controller(session, trajectory, controller)
             rms_tip_error_mm, held_cycles = result.rms_tip_error_mm, result.held_cycles
@@ -126,6 +128,7 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
             notifier.stop()
             monitor.shutdown()
         load = meter.report()
+        answers = session.testbed.answer_latency.summary()
         plant_rate_hz = session.backend.virtual.plant_rate_hz if session.backend.virtual is not None else None
         master_scheduling = session.scheduling.describe()
         command_process = commands_in_own_process(session, controller)
@@ -147,4 +150,5 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
             "realtime_priority": config.sync.realtime_priority, "master_scheduling": master_scheduling,
             "testbed_scheduling": testbed_scheduling, "commands_in_own_process": command_process,
             "cycles_held_for_a_command": held_cycles, "cycles_without_every_answer": unanswered_cycles,
+            "answer_latency": answers,
             "goal": "500 Hz with no missed cycle and p99 jitter <= 1 ms"}

@@ -20,6 +20,8 @@ its host is busy, since the testbed's time waits for the SYNCs). Once one drive 
 others get ``reply_timeout_s``, and a cycle in which no drive answered at all is followed by one
 with the ordinary patience (a testbed that is gone is found by the heartbeats, not waited for).
 
+``answer_latency`` keeps, in wall time, how long each cycle's answers took (answer_latency).
+
 ``quick_stop_all`` may be called from any thread: under the send lock it replaces every
 controlword by quick stop, sends it to every drive at once, and keeps sending it in every
 later cycle.
@@ -28,12 +30,14 @@ later cycle.
 from __future__ import annotations
 
 import threading
+import time
 from collections.abc import Callable, Sequence
 
 import can
 import canopen
 
 from crest.driver import cia402
+from crest.driver.answer_latency import AnswerLatency
 from crest.driver.clock import Clock
 from crest.driver.drive_axis import DriveAxis
 from crest.driver.heartbeat_producer import HeartbeatProducer
@@ -67,6 +71,7 @@ class SyncCycle:
         self.next_sync_s: float | None = None
         self.count = 0
         self.send_failures: list[str] = []
+        self.answer_latency = AnswerLatency()
 
     @property
     def started(self) -> bool:
@@ -89,6 +94,7 @@ class SyncCycle:
                 self._network.send_message(axis.rpdo_cob_id, axis.rpdo_data(self._override))
                 axis.sent_target_counts = axis.target_counts
             self._network.send_message(SYNC_COB_ID, b"")
+        sent_s = time.monotonic()
         self.count += 1
         if meanwhile is not None:
             meanwhile()
@@ -103,6 +109,10 @@ class SyncCycle:
                 timeout=self.reply_timeout_s)
             fresh = tuple(axis.tpdo_count >= due for axis, due in zip(self.axes, answer_at))
             received = [axis.tpdo_count - mark for axis, mark in zip(self.axes, marks)]
+        if all(fresh):
+            self.answer_latency.add(time.monotonic() - sent_s)
+        else:
+            self.answer_latency.add_unanswered()
         self._any_reply_last_cycle = any(received)
         self._late_reply_at = [mark + 1 if not is_fresh and count == 0 else None
                                for mark, is_fresh, count in zip(marks, fresh, received)]

@@ -34,6 +34,7 @@ import canopen
 
 from crest.config import TestbedConfig
 from crest.driver import cia402, homing, profile_position, state_control
+from crest.driver.answer_latency import AnswerLatency
 from crest.driver.axis_targets import AXIS_ORDER, AxisTargets
 from crest.driver.boot import reset_and_configure
 from crest.driver.cia402 import Cia402State, OperationMode
@@ -216,6 +217,11 @@ class Testbed:
     def safety_stop(self) -> SafetyStop | None:
         """The stop, once the testbed has been stopped."""
         return self._runner.safety_stop
+
+    @property
+    def answer_latency(self) -> AnswerLatency:
+        """How long the drives' answers to each SYNC took, in wall time (crest.driver.answer_latency)."""
+        return self._runner.sync.answer_latency
 
     @contextmanager
     def _guarded(self) -> Iterator[None]:

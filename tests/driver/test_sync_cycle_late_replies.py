@@ -117,3 +117,18 @@ def test_after_a_cycle_with_no_reply_at_all_the_next_waits_only_the_ordinary_rep
     for _ in range(3):
         assert cycle.run()[1] == (False, False)
     assert first_s >= 0.5 and time.monotonic() - started_s < first_s
+
+
+def test_each_cycle_records_how_long_its_answers_took_or_that_one_did_not_come():
+    changed = threading.Condition()
+    slow, prompt = StubAxis("tendon1", 1, changed), StubAxis("tendon2", 2, changed)
+    patient = SyncCycle(StubNetwork(), SteppedClock(), [slow, prompt], 0.01, NoHeartbeat(), changed,
+                        reply_timeout_s=30.0)
+    timer = threading.Timer(0.02, slow.reply)
+    patient.run(meanwhile=lambda: (timer.start(), prompt.reply()))   # slow answers 20 ms after the SYNC
+    timer.join()
+    assert patient.answer_latency.answered == 1 and patient.answer_latency.unanswered == 0
+    assert 0.02 <= patient.answer_latency.longest_s < 30.0
+    cycle, (silent, prompt) = make_cycle()
+    cycle.run(meanwhile=prompt.reply)                       # silent does not answer
+    assert cycle.answer_latency.answered == 0 and cycle.answer_latency.unanswered == 1
