@@ -154,7 +154,7 @@ def format_table(results: dict) -> str:
                      + (f"; {r['cycles_without_every_answer']} cycles without every drive's answer in time"
                         if r["cycles_without_every_answer"] is not None else "")
                      + "; answers {p50_ms:.2f} / {p99_ms:.2f} / {p99_9_ms:.2f} / {longest_ms:.2f} ms after the SYNC "
-                       "(p50 / p99 / p99.9 / longest)".format(**r["answer_latency"]),
+                       "(p50 / p99 / p99.9 / longest)".format(**r["answer_latency"])
                      + (f"; stopped: {r['stopped']}" if r["stopped"] else ""),
                      "rate held, 0 missed (SYNC late or an answer late), p99 <= 1 ms",
                      not r["stopped"] and r["missed_cycles"] == 0 and r["cycles_without_every_answer"] == 0
