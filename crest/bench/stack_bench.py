@@ -9,9 +9,9 @@ what each process got.
 Measured from the SYNC frames on the bus (a further handle on the bus timestamps them):
 the achieved rate, the period jitter (|period - nominal|, p50/p99), missed cycles (a period
 longer than 1.5 nominal periods) and the bus load the traffic would put on a real bus. From the
-run itself: the cycles in which a drive's answer did not come before the next SYNC was due (the
-SYNC does not wait for it in real time, crest.driver.sync_cycle; that row lacks the answer), which
-the goal counts as missed too; and how long the drives' answers took after each SYNC, as the master
+run itself: the cycles in which a drive's answer did not come within the master's reply time
+(crest.driver.sync_cycle: two periods, at least 20 ms, in real time; such a row lacks the answer),
+which the goal counts as missed too; and how long the drives' answers took after each SYNC, as the master
 saw them (crest.driver.answer_latency: p50, p99, p99.9, longest), where the cycle's time goes.
 """
 from __future__ import annotations

@@ -170,8 +170,9 @@ def _report(result) -> None:
            else f"RMS tip error {result.rms_tip_error_mm:.2f} mm over {result.tip_samples} tracker samples")
     held = (f"{result.held_cycles} cycles held for a command not yet computed (the trajectory ran that much "
             "later)" if result.held_cycles else None)
-    unanswered = (f"{result.unanswered_cycles} cycles without every drive's answer in time (their rows "
-                  "leave those cells empty)" if result.unanswered_cycles else None)
+    unanswered = (f"{result.unanswered_cycles} cycles without every drive's answer in time"
+                  + (" (their rows leave those cells empty)" if result.log_path else "")
+                  if result.unanswered_cycles else None)
     parts = [f"ran {result.cycles} cycles", held, unanswered, result.tip_coverage.loss_sentence(), rms,
              f"log: {result.log_path}" if result.log_path else None]
     print("; ".join(part for part in parts if part), file=sys.stdout)
