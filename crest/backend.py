@@ -21,7 +21,8 @@ from __future__ import annotations
 
 import itertools
 import os
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -67,6 +68,34 @@ class Backend:
         if self.virtual is None:
             return None
         return can.Bus(interface="virtual", channel=self.virtual.channel)
+
+    @contextmanager
+    def tapped(self, listener: can.Listener) -> Iterator[bool]:
+        """`listener` sees every frame on the bus, the host's included, until the block ends (yields
+        False where nothing can be tapped: hardware). On a served testbed it sees them on the host's
+        own connection, as they are sent and received (a second client would have the testbed send
+        every frame twice, and give this process a receive thread more); in this process through a
+        second handle on the virtual bus."""
+        if self.served is not None:
+            hooks = (self.bus.receive_hooks, self.bus.send_hooks)
+            for frames in hooks:
+                frames.append(listener.on_message_received)
+            try:
+                yield True
+            finally:
+                for frames in hooks:
+                    frames.remove(listener.on_message_received)
+            return
+        monitor = self.monitor_bus()
+        if monitor is None:
+            yield False
+            return
+        notifier = can.Notifier(monitor, [listener], timeout=0.1)
+        try:
+            yield True
+        finally:
+            notifier.stop()
+            monitor.shutdown()
 
     def start_fault_clock(self) -> None:
         """The virtual testbed's --fault times count from now (the start of the run's motion):

@@ -6,9 +6,10 @@ Each set-up runs under the normal scheduler or with the threads of both processe
 (the configuration's [sync] realtime_priority, crest.driver.realtime_scheduling); the result says
 what each process got.
 
-Measured from the SYNC frames on the bus (a further handle on the bus timestamps them):
-the achieved rate, the period jitter (|period - nominal|, p50/p99), missed cycles (a period
-longer than 1.5 nominal periods) and the bus load the traffic would put on a real bus. From the
+Measured by the master as it sends the SYNCs (crest.driver.sync_timing; a second client on the
+bus would load the cycle it measures): the achieved rate, the period jitter (|period - nominal|,
+p50/p99) and missed cycles (a period longer than 1.5 nominal periods). From every frame the master
+sends and receives (Backend.tapped): the bus load the traffic would put on a real bus. From the
 run itself: the cycles in which a drive's answer did not come within the master's reply time
 (crest.driver.sync_cycle: two periods, at least 20 ms, in real time; such a row lacks the answer),
 which the goal counts as missed too; and how long the drives' answers took after each SYNC, as the master
@@ -24,9 +25,6 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-import can
-import numpy as np
-
 from control import Articulation, make_controller
 from crest.config import default_config_path, load_testbed_config
 from crest.driver import SafetyStop
@@ -37,17 +35,6 @@ from crest.session import SessionOptions, open_session
 from crest.testbed_service.auto_start import MODE_VARIABLE
 from model import CatheterParams
 from sim_backend.bus_load import BusLoadMeter
-
-SYNC_COB_ID = 0x80
-
-
-class SyncTimes(can.Listener):
-    def __init__(self):
-        self.timestamps: list[float] = []
-
-    def on_message_received(self, msg: can.Message) -> None:
-        if msg.arbitration_id == SYNC_COB_ID and not msg.is_error_frame:
-            self.timestamps.append(msg.timestamp)
 
 
 def full_stack(sync_rate_hz: float = 500.0, duration_s: float = 60.0, controller_name: str = "dahl",
@@ -113,20 +100,17 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
         # into cyclic synchronous position before the timing starts: the change of operation mode is
         # an SDO exchange between two SYNCs, not a cycle of the control loop
         session.testbed.cycle(session.testbed.positions())
-        monitor = session.backend.monitor_bus()
-        listener = SyncTimes()
         meter = BusLoadMeter(config.bus.bitrate, period_s)      # what the frames on the wire take
-        notifier = can.Notifier(monitor, [listener, meter], timeout=0.1)
         session.testbed.answer_latency.reset()
-        try:
-            result = run_with_controller(session, trajectory, controller)
-            rms_tip_error_mm, held_cycles = result.rms_tip_error_mm, result.held_cycles
-            unanswered_cycles = result.unanswered_cycles
-        except SafetyStop as stop:
-            stopped = str(stop)
-        finally:
-            notifier.stop()
-            monitor.shutdown()
+        session.testbed.sync_timing.reset()
+        with session.backend.tapped(meter):
+            try:
+                result = run_with_controller(session, trajectory, controller)
+                rms_tip_error_mm, held_cycles = result.rms_tip_error_mm, result.held_cycles
+                unanswered_cycles = result.unanswered_cycles
+            except SafetyStop as stop:
+                stopped = str(stop)
+            timing = session.testbed.sync_timing.summary()
         load = meter.report()
         answers = session.testbed.answer_latency.summary()
         plant_rate_hz = session.backend.virtual.plant_rate_hz if session.backend.virtual is not None else None
@@ -134,16 +118,11 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
         command_process = commands_in_own_process(session, controller)
         testbed_scheduling = (session.backend.served.scheduling if session.backend.served is not None
                               else master_scheduling)
-    stamps = np.array(listener.timestamps)
-    periods = np.diff(stamps)
-    jitter = np.abs(periods - period_s)
-    missed = int(np.sum(periods > 1.5 * period_s))
-    return {"sync_rate_hz_nominal": sync_rate_hz, "duration_s": float(stamps[-1] - stamps[0]),
-            "controller": controller_name, "cycles": int(len(periods)),
-            "achieved_rate_hz": float(len(periods) / (stamps[-1] - stamps[0])),
-            "jitter_p50_ms": float(1e3 * np.percentile(jitter, 50)),
-            "jitter_p99_ms": float(1e3 * np.percentile(jitter, 99)),
-            "missed_cycles": missed, "longest_period_ms": float(1e3 * periods.max()),
+    return {"sync_rate_hz_nominal": sync_rate_hz, "duration_s": (timing["syncs"] - 1) / timing["achieved_rate_hz"],
+            "controller": controller_name, "cycles": timing["syncs"] - 1,
+            "achieved_rate_hz": timing["achieved_rate_hz"], "jitter_p50_ms": timing["jitter_p50_ms"],
+            "jitter_p99_ms": timing["jitter_p99_ms"], "missed_cycles": timing["missed_cycles"],
+            "longest_period_ms": timing["longest_period_ms"],
             "bus_load_mean": float(load.mean_load), "bus_load_max": float(load.max_load),
             "bus_bitrate_bit_s": int(load.bitrate_bit_s), "cycles_over_bus_capacity": len(load.overloaded),
             "rms_tip_error_mm": rms_tip_error_mm, "plant_rate_hz": plant_rate_hz, "stopped": stopped,

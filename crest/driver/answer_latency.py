@@ -6,47 +6,42 @@ SYNC only after that wait and the cycle's own work, so on a served virtual testb
 answer crosses two processes and a WebSocket, this latency is most of the SYNC period; its tail is
 what makes a SYNC late (README, "Full stack across the process boundary").
 
-Latencies go into a histogram of BIN_S bins up to LONGEST_BIN_S (the last bin holds everything
-longer), so a run of any length keeps a fixed memory; percentiles are read to a bin, the longest
-exactly. Cycles in which some drive did not answer in time have no latency and are counted apart.
+Latencies are kept in a fixed-memory histogram (wall_time_histogram). Cycles in which some drive
+did not answer in time have no latency and are counted apart.
 """
 from __future__ import annotations
 
-import bisect
-import itertools
-
-BIN_S = 1e-5
-LONGEST_BIN_S = 0.05
+from crest.driver.wall_time_histogram import WallTimeHistogram
 
 
 class AnswerLatency:
     def __init__(self) -> None:
-        self.reset()
+        self._latencies = WallTimeHistogram()
+        self.unanswered = 0
 
     def reset(self) -> None:
-        self._counts = [0] * (int(round(LONGEST_BIN_S / BIN_S)) + 1)
-        self.answered = 0
+        self._latencies.reset()
         self.unanswered = 0
-        self.longest_s = 0.0
+
+    @property
+    def answered(self) -> int:
+        return self._latencies.count
+
+    @property
+    def longest_s(self) -> float:
+        return self._latencies.longest_s
 
     def add(self, latency_s: float) -> None:
         """A cycle whose answers all came, `latency_s` after its SYNC."""
-        self._counts[min(int(latency_s / BIN_S), len(self._counts) - 1)] += 1
-        self.answered += 1
-        self.longest_s = max(self.longest_s, latency_s)
+        self._latencies.add(latency_s)
 
     def add_unanswered(self) -> None:
         """A cycle in which some drive's answer did not come in time."""
         self.unanswered += 1
 
     def percentile_s(self, percent: float) -> float:
-        """The latency below which `percent` % of the answered cycles fall: the upper edge of the bin
-        holding that rank (NaN before any answered cycle)."""
-        if not self.answered:
-            return float("nan")
-        rank = max(1, int(round(percent / 100.0 * self.answered)))
-        cumulative = list(itertools.accumulate(self._counts))
-        return min((bisect.bisect_left(cumulative, rank) + 1) * BIN_S, self.longest_s)
+        """The latency below which `percent` % of the answered cycles fall (NaN before any)."""
+        return self._latencies.percentile_s(percent)
 
     def summary(self) -> dict:
         """{"answered", "unanswered", "p50_ms", "p99_ms", "p99_9_ms", "longest_ms"}."""

@@ -20,7 +20,8 @@ its host is busy, since the testbed's time waits for the SYNCs). Once one drive 
 others get ``reply_timeout_s``, and a cycle in which no drive answered at all is followed by one
 with the ordinary patience (a testbed that is gone is found by the heartbeats, not waited for).
 
-``answer_latency`` keeps, in wall time, how long each cycle's answers took (answer_latency).
+``answer_latency`` keeps, in wall time, how long each cycle's answers took (answer_latency), and
+``timing`` when each SYNC left (sync_timing).
 
 ``quick_stop_all`` may be called from any thread: under the send lock it replaces every
 controlword by quick stop, sends it to every drive at once, and keeps sending it in every
@@ -41,6 +42,7 @@ from crest.driver.answer_latency import AnswerLatency
 from crest.driver.clock import Clock
 from crest.driver.drive_axis import DriveAxis
 from crest.driver.heartbeat_producer import HeartbeatProducer
+from crest.driver.sync_timing import SyncTiming
 
 SYNC_COB_ID = 0x80
 
@@ -72,6 +74,7 @@ class SyncCycle:
         self.count = 0
         self.send_failures: list[str] = []
         self.answer_latency = AnswerLatency()
+        self.timing = SyncTiming(period_s)
 
     @property
     def started(self) -> bool:
@@ -95,6 +98,7 @@ class SyncCycle:
                 axis.sent_target_counts = axis.target_counts
             self._network.send_message(SYNC_COB_ID, b"")
         sent_s = time.monotonic()
+        self.timing.sent(sent_s)
         self.count += 1
         if meanwhile is not None:
             meanwhile()

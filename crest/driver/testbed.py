@@ -50,6 +50,7 @@ from crest.driver.motion_limits import SetPointLimiter, check_positions, check_t
 from crest.driver.safety_monitor import ErrorFrameListener, SafetyMonitor
 from crest.driver.stop_causes import emcy_text, operator_cause, tracker_cause
 from crest.driver.sync_cycle import SyncCycle
+from crest.driver.sync_timing import SyncTiming
 from crest.driver.synchronized_move import AxisProfile, synchronized_move
 
 NMT_START = 0x01
@@ -222,6 +223,11 @@ class Testbed:
     def answer_latency(self) -> AnswerLatency:
         """How long the drives' answers to each SYNC took, in wall time (crest.driver.answer_latency)."""
         return self._runner.sync.answer_latency
+
+    @property
+    def sync_timing(self) -> SyncTiming:
+        """When each SYNC left, as the master times them (crest.driver.sync_timing)."""
+        return self._runner.sync.timing
 
     @contextmanager
     def _guarded(self) -> Iterator[None]:

@@ -26,6 +26,7 @@ class ServedBus(RemoteBus):
     def __init__(self, channel: str, **config) -> None:
         self.lost: Exception | None = None
         self.receive_hooks: list[Callable[[can.Message], None]] = []   # each sees every frame received
+        self.send_hooks: list[Callable[[can.Message], None]] = []      # ... and sent
         self._closed = threading.Event()
         super().__init__(channel, **config)
 
@@ -49,6 +50,9 @@ class ServedBus(RemoteBus):
                 super().send(msg, timeout)
             except CONNECTION_ERRORS as exc:
                 self.lost = exc
+            else:
+                for hook in self.send_hooks:
+                    hook(msg)
 
     def shutdown(self) -> None:
         self._closed.set()

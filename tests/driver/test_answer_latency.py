@@ -4,7 +4,8 @@ import math
 
 import pytest
 
-from crest.driver.answer_latency import BIN_S, AnswerLatency
+from crest.driver.answer_latency import AnswerLatency
+from crest.driver.wall_time_histogram import BIN_S
 
 
 def test_percentiles_are_read_to_a_bin_and_the_longest_exactly():
