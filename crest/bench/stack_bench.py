@@ -118,8 +118,8 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
         command_process = commands_in_own_process(session, controller)
         testbed_scheduling = (session.backend.served.scheduling if session.backend.served is not None
                               else master_scheduling)
-    return {"sync_rate_hz_nominal": sync_rate_hz, "duration_s": (timing["syncs"] - 1) / timing["achieved_rate_hz"],
-            "controller": controller_name, "cycles": timing["syncs"] - 1,
+    return {"sync_rate_hz_nominal": sync_rate_hz, "duration_s": timing["span_s"],
+            "controller": controller_name, "cycles": timing["periods"],
             "achieved_rate_hz": timing["achieved_rate_hz"], "jitter_p50_ms": timing["jitter_p50_ms"],
             "jitter_p99_ms": timing["jitter_p99_ms"], "missed_cycles": timing["missed_cycles"],
             "longest_period_ms": timing["longest_period_ms"],

@@ -49,10 +49,11 @@ class SyncTiming:
         self.syncs += 1
 
     def summary(self) -> dict:
-        """{"syncs", "achieved_rate_hz", "jitter_p50_ms", "jitter_p99_ms", "missed_cycles",
-        "longest_period_ms"} since the last reset (rate and jitter NaN before two SYNCs)."""
+        """{"syncs", "periods", "span_s", "achieved_rate_hz", "jitter_p50_ms", "jitter_p99_ms",
+        "missed_cycles", "longest_period_ms"} since the last reset (rate and jitter NaN before two
+        SYNCs)."""
         span_s = (self._last_s - self._first_s) if self.syncs >= 2 else 0.0
-        return {"syncs": self.syncs,
+        return {"syncs": self.syncs, "periods": max(self.syncs - 1, 0), "span_s": span_s,
                 "achieved_rate_hz": (self.syncs - 1) / span_s if span_s > 0 else float("nan"),
                 "jitter_p50_ms": 1e3 * self._jitter.percentile_s(50.0),
                 "jitter_p99_ms": 1e3 * self._jitter.percentile_s(99.0),

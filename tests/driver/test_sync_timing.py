@@ -14,7 +14,8 @@ def test_a_late_sync_is_one_missed_cycle_and_the_longest_period():
     for t in sent_s:
         timing.sent(t)
     summary = timing.summary()
-    assert summary["syncs"] == 100 and summary["missed_cycles"] == 1
+    assert summary["syncs"] == 100 and summary["periods"] == 99 and summary["missed_cycles"] == 1
+    assert summary["span_s"] == pytest.approx(0.198)
     assert summary["longest_period_ms"] == pytest.approx(3.1)
     assert summary["achieved_rate_hz"] == pytest.approx(500.0)
     assert summary["jitter_p50_ms"] <= 0.01 and 1.09 <= summary["jitter_p99_ms"] <= 1.11
@@ -26,4 +27,6 @@ def test_a_period_of_one_and_a_half_is_not_missed_and_reset_forgets():
         timing.sent(t)
     assert timing.summary()["missed_cycles"] == 0
     timing.reset()
-    assert timing.summary()["syncs"] == 0 and math.isnan(timing.summary()["achieved_rate_hz"])
+    summary = timing.summary()
+    assert summary["syncs"] == 0 and summary["periods"] == 0 and summary["span_s"] == 0.0
+    assert math.isnan(summary["achieved_rate_hz"])
