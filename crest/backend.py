@@ -30,6 +30,7 @@ import can
 
 from crest.config import TestbedConfig, load_testbed_config
 from crest.config.testbed_config import AxisConfig
+from crest.driver.hooked_bus import HookedBus
 from crest.testbed_service import ServedTestbed, config_digest, running_testbed
 from crest.testbed_service.auto_start import MODE_VARIABLE, OwnedTestbed, start_owned_testbed, wants_own_process
 from crest.testbed_service.clock_claim import claim_clock
@@ -49,7 +50,7 @@ class BackendError(ValueError):
 class Backend:
     """An opened testbed: the host's CAN bus, the tracker's serial port, and the simulator if virtual."""
 
-    bus: can.BusABC
+    bus: HookedBus
     tracker_port: str
     virtual: object | None = None   # sim_backend.VirtualTestbed when simulated in this process
     served: ServedTestbed | None = None   # the served virtual testbed this process joined
@@ -61,41 +62,16 @@ class Backend:
     def is_virtual(self) -> bool:
         return self.virtual is not None or self.served is not None
 
-    def monitor_bus(self) -> can.BusABC | None:
-        """A second handle that sees every frame on the bus, the host's included (virtual testbed only)."""
-        if self.served is not None:
-            return ServedBus(self.served.bus_channel)
-        if self.virtual is None:
-            return None
-        return can.Bus(interface="virtual", channel=self.virtual.channel)
-
     @contextmanager
-    def tapped(self, listener: can.Listener) -> Iterator[bool]:
-        """`listener` sees every frame on the bus, the host's included, until the block ends (yields
-        False where nothing can be tapped: hardware). On a served testbed it sees them on the host's
-        own connection, as they are sent and received (a second client would have the testbed send
-        every frame twice, and give this process a receive thread more); in this process through a
-        second handle on the virtual bus."""
-        if self.served is not None:
-            hooks = (self.bus.receive_hooks, self.bus.send_hooks)
-            for frames in hooks:
-                frames.append(listener.on_message_received)
-            try:
-                yield True
-            finally:
-                for frames in hooks:
-                    frames.remove(listener.on_message_received)
-            return
-        monitor = self.monitor_bus()
-        if monitor is None:
-            yield False
-            return
-        notifier = can.Notifier(monitor, [listener], timeout=0.1)
+    def tapped(self, listener: can.Listener) -> Iterator[None]:
+        """`listener` sees every frame the host sends and receives until the block ends, on the host's
+        own handle (crest.driver.hooked_bus: a second handle would miss the host's frames on hardware,
+        and have a served testbed send every frame twice)."""
+        self.bus.tap(listener.on_message_received)
         try:
-            yield True
+            yield
         finally:
-            notifier.stop()
-            monitor.shutdown()
+            self.bus.untap(listener.on_message_received)
 
     def start_fault_clock(self) -> None:
         """The virtual testbed's --fault times count from now (the start of the run's motion):
@@ -116,7 +92,7 @@ class Backend:
         if self.virtual is not None:
             self.virtual.tick(now_s)
         elif self.stamp_answers is not None:
-            self.stamp_answers.wait_for_last(STAMP_ANSWER_TIMEOUT_S, gone=lambda: self.bus.lost is not None)
+            self.stamp_answers.wait_for_last(STAMP_ANSWER_TIMEOUT_S, gone=lambda: self.bus.inner.lost is not None)
             self.bus.send(time_stamp_frame(now_s))
             self.stamp_answers.sent(now_s)
 
@@ -159,7 +135,7 @@ def open_backend(config: TestbedConfig, *, plant: str | None = None, plant_confi
         if config.tracker.port == "sim":
             raise BackendError(f"{config.path}: [tracker].port = 'sim' needs the virtual testbed; "
                                "set it to the tracker's serial device")
-        return Backend(bus=_open_hardware_bus(config), tracker_port=config.tracker.port)
+        return Backend(bus=HookedBus(_open_hardware_bus(config)), tracker_port=config.tracker.port)
     effects = effects or {}
     if in_process:
         return _open_virtual(config, plant, plant_config, faults, effects, realtime, tracker_noise_mm, tracker_dropout)
@@ -229,11 +205,11 @@ def _open_owned(config: TestbedConfig, plant: str | None, plant_config: Path | N
 def _joined(config: TestbedConfig, served: ServedTestbed) -> Backend:
     """The backend of a served testbed, joined; in simulated time its bus hands every frame to the
     answers of the TIME stamps (sim_backend.time_stamps)."""
-    bus = _join_served(config, served)
+    bus = HookedBus(_join_served(config, served))
     backend = Backend(bus=bus, tracker_port=served.tracker_port, served=served)
     if served.simulated_time:
         backend.stamp_answers = StampAnswers()
-        bus.receive_hooks.append(backend.stamp_answers.on_frame)
+        bus.receive_hooks = [backend.stamp_answers.on_frame]
     return backend
 
 
@@ -285,7 +261,7 @@ def _open_virtual(config: TestbedConfig, plant_spec: str | None, plant_toml: Pat
     testbed = _virtual_testbed(config, channel, plant_spec, plant_toml, fault_texts, effects, True,
                                tracker_noise_mm, tracker_dropout)
     testbed.start(realtime=realtime)
-    bus = can.Bus(interface="virtual", channel=channel, receive_own_messages=False)
+    bus = HookedBus(can.Bus(interface="virtual", channel=channel, receive_own_messages=False))
     return Backend(bus=bus, tracker_port=testbed.tracker_port, virtual=testbed)
 
 

@@ -4,10 +4,9 @@ All drives share one python-can ``virtual`` bus instance and one canopen.Network
 (its notifier thread runs their callbacks). A client (the crest driver, or
 canopen.RemoteNode / BaseNode402 in tests) opens its own
 ``can.Bus(interface="virtual", channel=<same channel>)`` and talks to them as to
-hardware. Whoever wants the bus load feeds a ``sim_backend.bus_load.BusLoadMeter`` from a
-handle of its own (as `crest bench` does with the testbed in its process; crest.backend's
-``Backend.tapped``): every further handle costs each frame a copy and a thread wake-up, so the
-drives keep none for it.
+hardware. Whoever wants the bus load feeds a ``sim_backend.bus_load.BusLoadMeter`` from the
+frames it sees (`crest bench` taps the host's own handle, crest.driver.hooked_bus): every further
+handle on the bus costs each frame a copy and a thread wake-up, so the drives keep none for it.
 
 ``tick(now_s)`` (s since the testbed started) drives the drives' time-based
 duties and fires scheduled per-axis faults; SYNC frames from the client drive

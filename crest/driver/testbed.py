@@ -126,13 +126,6 @@ class Testbed:
         self._limiters = {axis.name: SetPointLimiter(axis.config, period_s, 0.0) for axis in self._axis_list}
 
     # --- life cycle ------------------------------------------------------------------------
-    def add_listener(self, listener: can.Listener) -> None:
-        """Also hand every received frame to `listener` (e.g. the bus recorder)."""
-        if self._network.notifier is None:
-            self._network.listeners.append(listener)
-        else:
-            self._network.notifier.add_listener(listener)
-
     def connect(self) -> None:
         """Start listening on the bus (boot does this; ``status`` works after it alone)."""
         if self._network.notifier is None:

@@ -53,13 +53,8 @@ class ExperimentRecorder:
             notes=notes, config=config.as_dict(), overwrite=overwrite)
         self.bus_log_path = csv_path.with_suffix(".blf")
         self.bus = BusRecorder(self.bus_log_path)
-        monitor = session.backend.monitor_bus()
-        if monitor is not None:
-            self.bus.listen(monitor)
-            self._monitor = monitor
-        else:
-            self._monitor = None
-            session.testbed.add_listener(self.bus)
+        self._host_bus = session.backend.bus
+        self._host_bus.tap(self.bus.on_message_received)     # what the host sends and receives
         self.tip_coverage = TipCoverage(config.tracker.loss_timeout_s if session.tracker is not None else None)
         self.feedback_coverage = DriveFeedbackCoverage(AXIS_ORDER)
         session.testbed.on_safety_stop(self._on_safety_stop)
@@ -87,9 +82,8 @@ class ExperimentRecorder:
             return
         self.closed = True
         self.writer.close({**self.tip_coverage.summary(), **self.feedback_coverage.summary(), **(summary or {})})
+        self._host_bus.untap(self.bus.on_message_received)
         self.bus.close()
-        if self._monitor is not None:
-            self._monitor.shutdown()
 
     def _on_safety_stop(self, stop: SafetyStop) -> None:
         """The stop cause into the sidecar; a stop after the log was closed (while the session is

@@ -11,8 +11,6 @@ it would on hardware; `lost` keeps what ended the connection.
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable
-
 import can
 from can_remote.client import RemoteBus
 from can_remote.websocket import WebsocketClosed
@@ -25,8 +23,6 @@ class ServedBus(RemoteBus):
 
     def __init__(self, channel: str, **config) -> None:
         self.lost: Exception | None = None
-        self.receive_hooks: list[Callable[[can.Message], None]] = []   # each sees every frame received
-        self.send_hooks: list[Callable[[can.Message], None]] = []      # ... and sent
         self._closed = threading.Event()
         super().__init__(channel, **config)
 
@@ -37,9 +33,6 @@ class ServedBus(RemoteBus):
             except CONNECTION_ERRORS as exc:
                 self.lost = exc
             else:
-                if msg is not None:
-                    for hook in self.receive_hooks:
-                        hook(msg)
                 return msg
         self._closed.wait(timeout)
         return None
@@ -50,9 +43,6 @@ class ServedBus(RemoteBus):
                 super().send(msg, timeout)
             except CONNECTION_ERRORS as exc:
                 self.lost = exc
-            else:
-                for hook in self.send_hooks:
-                    hook(msg)
 
     def shutdown(self) -> None:
         self._closed.set()

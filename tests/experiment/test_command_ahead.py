@@ -1,6 +1,7 @@
 """A controller that ignores what was measured computes its next command while the drives answer
 the SYNC (crest.experiment.controlled_run): the same commands, the same rows, the same errors
 as computed one after the other, only off the cycle's critical path."""
+import can
 import numpy as np
 import pytest
 
@@ -49,7 +50,7 @@ def run(controller, *, uses_feedback, fail_at=None):
     command = controller.command
     with open_session(SessionOptions(realtime=False, in_process=True)) as session:
         session.testbed.home()
-        events = Events(session.backend.monitor_bus())
+        events = Events(can.Bus(interface="virtual", channel=session.backend.virtual.channel))
 
         def observed(*args, **kwargs):
             events.on_command()

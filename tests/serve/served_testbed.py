@@ -111,6 +111,15 @@ def wait_gone(pid: int, state_file: Path) -> None:
         time.sleep(0.2)
 
 
+def established_connections(port: int) -> int:
+    """TCP connections on 127.0.0.1 whose server side is `port` (the kernel's table, /proc/net/tcp)."""
+    count = 0
+    for line in open("/proc/net/tcp").read().splitlines()[1:]:
+        local, state = line.split()[1], line.split()[3]
+        count += int(local.split(":")[1], 16) == port and state == "01"
+    return count
+
+
 def rows_on_disk(log_path: Path) -> int:
     return log_path.read_bytes().count(b"\n") - 1 if log_path.exists() else 0
 

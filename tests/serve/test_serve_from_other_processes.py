@@ -11,6 +11,7 @@ import signal
 import subprocess
 import sys
 import time
+from urllib.parse import urlsplit
 
 import can
 import numpy as np
@@ -18,8 +19,8 @@ import pytest
 
 from crest.exit_codes import ExitCode
 from crest.log import read_log
-from served_testbed import (HEARTBEAT_TIMEOUT_S, crest_lines, rows_on_disk, start_run, start_served_testbed,
-                            status_rows, stop, wait_for_rows)
+from served_testbed import (HEARTBEAT_TIMEOUT_S, crest_lines, established_connections, rows_on_disk, start_run,
+                            start_served_testbed, status_rows, stop, wait_for_rows)
 from tests.cli.cli_runner import REPO, crest
 
 AXES = ("tendon1", "tendon2", "tendon3", "tendon4", "insertion")
@@ -41,6 +42,8 @@ def served(tmp_path):
 def test_status_and_the_can_logger_watch_a_run_from_other_processes_without_disturbing_it(served, tmp_path):
     log_path = tmp_path / "run.csv"
     run = start_run(served, log_path)
+    # the recording run is one client of the bus: it records on its own connection, not a second one
+    assert established_connections(urlsplit(served.state["bus_channel"]).port) == 1
     logger_out = tmp_path / "logger.txt"
     with logger_out.open("w") as sink:
         logger = subprocess.Popen([sys.executable, "-m", "can.logger", "-i", "remote", "-c", served.state["bus_channel"]],
@@ -88,7 +91,7 @@ def test_estop_from_another_process_stops_every_axis_and_the_run_exits_with_its_
     assert len(lines) == 1 and "without a command from this host (crest estop" in lines[0], stderr
     summary = json.loads(log_path.with_suffix(".json").read_text())["summary"]
     assert summary["exit_code"] == ExitCode.ERROR and "crest estop" in summary["stop_cause"]
-    # The run's CAN recording, made through its own handle on the served bus, holds the estop's
+    # The run's CAN recording, made on its own connection to the served bus, holds the estop's
     # quick stop to tendon1, the first it stops: a frame another process sent. (The run stops
     # itself on that first stopped axis and closes its recording while estop goes on.)
     frames = list(can.LogReader(log_path.with_suffix(".blf")))
