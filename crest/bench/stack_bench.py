@@ -14,6 +14,8 @@ run itself: the cycles in which a drive's answer did not come within the master'
 (crest.driver.sync_cycle: two periods, at least 20 ms, in real time; such a row lacks the answer),
 which the goal counts as missed too; and how long the drives' answers took after each SYNC, as the master
 saw them (crest.driver.answer_latency: p50, p99, p99.9, longest), where the cycle's time goes.
+From the kernel: the time the hypervisor took from each CPU during the run (crest.bench.steal_time),
+when every thread on that CPU stood still.
 """
 from __future__ import annotations
 
@@ -26,6 +28,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from control import Articulation, make_controller
+from crest.bench.steal_time import StealMeter
 from crest.config import default_config_path, load_testbed_config
 from crest.driver import SafetyStop
 from crest.experiment.builtin_trajectories import BuiltinOptions, builtin_trajectory
@@ -103,6 +106,8 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
         meter = BusLoadMeter(config.bus.bitrate, period_s)      # what the frames on the wire take
         session.testbed.answer_latency.reset()
         session.testbed.sync_timing.reset()
+        steal = StealMeter()
+        steal.start()
         with session.backend.tapped(meter):
             try:
                 result = run_with_controller(session, trajectory, controller)
@@ -111,6 +116,7 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
             except SafetyStop as stop:
                 stopped = str(stop)
             timing = session.testbed.sync_timing.summary()
+        stolen = steal.stop()
         load = meter.report()
         answers = session.testbed.answer_latency.summary()
         plant_rate_hz = session.backend.virtual.plant_rate_hz if session.backend.virtual is not None else None
@@ -129,5 +135,5 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
             "realtime_priority": config.sync.realtime_priority, "master_scheduling": master_scheduling,
             "testbed_scheduling": testbed_scheduling, "commands_in_own_process": command_process,
             "cycles_held_for_a_command": held_cycles, "cycles_without_every_answer": unanswered_cycles,
-            "answer_latency": answers,
+            "answer_latency": answers, "hypervisor": stolen,
             "goal": "500 Hz with no missed cycle and p99 jitter <= 1 ms"}

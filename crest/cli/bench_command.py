@@ -101,6 +101,14 @@ def machine_floor_result(duration_s: float, stack_priority: int) -> dict:
             "stalls_over_1_ms_on_every_cpu": floor.on_every_cpu(0.001)}
 
 
+def _steal_text(hypervisor: dict) -> str:
+    """The hypervisor's steal time during one stack run (crest.bench.steal_time), or nothing."""
+    if not hypervisor["steal_ms_per_cpu"]:
+        return ""
+    per_cpu = ", ".join(f"CPU {cpu} {ms:g} ms" for cpu, ms in hypervisor["steal_ms_per_cpu"].items())
+    return f"; taken by the hypervisor during the run: {per_cpu} (to {hypervisor['resolution_ms']:g} ms)"
+
+
 def format_table(results: dict) -> str:
     rows = []
     if "model" in results:
@@ -155,6 +163,7 @@ def format_table(results: dict) -> str:
                         if r["cycles_without_every_answer"] is not None else "")
                      + "; answers {p50_ms:.2f} / {p99_ms:.2f} / {p99_9_ms:.2f} / {longest_ms:.2f} ms after the SYNC "
                        "(p50 / p99 / p99.9 / longest)".format(**r["answer_latency"])
+                     + _steal_text(r["hypervisor"])
                      + (f"; stopped: {r['stopped']}" if r["stopped"] else ""),
                      "rate held, 0 missed (SYNC late or an answer late), p99 <= 1 ms",
                      not r["stopped"] and r["missed_cycles"] == 0 and r["cycles_without_every_answer"] == 0

@@ -8,6 +8,7 @@ STACK = {"sync_rate_hz_nominal": 500.0, "duration_s": 60.0, "testbed": "its own 
          "bus_bitrate_bit_s": 1_000_000, "cycles_held_for_a_command": 0, "cycles_without_every_answer": 3,
          "answer_latency": {"answered": 29997, "unanswered": 3, "p50_ms": 1.01, "p99_ms": 1.55,
                             "p99_9_ms": 1.83, "longest_ms": 7.1},
+         "hypervisor": {"steal_ms_per_cpu": {"0": 0.0, "1": 10.0}, "resolution_ms": 10.0},
          "stopped": None}
 FLOOR = {"duration_s": 60.0, "period_s": 0.001, "probe": "real-time", "wakeups": 120000, "stalls": 2,
          "stall_threshold_s": 0.0005, "stalls_over_1_ms": 1, "longest_ms": 3.5,
@@ -19,6 +20,7 @@ def test_the_full_stack_row_names_late_answers_and_the_answer_latency_and_fails_
     row = next(line for line in table.splitlines() if line.startswith("| Full stack at 500 Hz"))
     assert "3 cycles without every drive's answer in time" in row
     assert "answers 1.01 / 1.55 / 1.83 / 7.10 ms after the SYNC" in row
+    assert "taken by the hypervisor during the run: CPU 0 0 ms, CPU 1 10 ms (to 10 ms)" in row
     assert row.rstrip().endswith("| NO |")          # 0 SYNCs missed, but 3 answers late
     floor = next(line for line in table.splitlines() if line.startswith("| Machine floor"))
     assert "1 stalls over 1 ms on any CPU" in floor and "CPU 0: 1, CPU 1: 1; 1 on every CPU at once" in floor
