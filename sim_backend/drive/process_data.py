@@ -75,6 +75,9 @@ class ProcessData:
         self._sync_count: dict[int, int] = {}
         self._last_sent: dict[int, bytes] = {}
         self._pending_rpdo: dict[int, bytes] = {}
+        # canopen's PdoMaps is a Mapping walked key by key; its maps are made once, with the node
+        self._rpdo_maps = tuple(node.rpdo.map.maps.values())
+        self._tpdo_maps = tuple(node.tpdo.map.maps.values())
 
     # --- configuration -------------------------------------------------------------
     def load(self) -> None:
@@ -92,7 +95,7 @@ class ProcessData:
                     self._reload(maps[index - base + 1])
 
     def _all_maps(self) -> list[PdoMap]:
-        return list(self._node.rpdo.map.values()) + list(self._node.tpdo.map.values())
+        return [*self._rpdo_maps, *self._tpdo_maps]
 
     def _reload(self, pdo_map: PdoMap) -> None:
         network = self._node.network
@@ -103,7 +106,7 @@ class ProcessData:
         self._sync_count[key] = 0
         self._last_sent.pop(key, None)
         self._pending_rpdo.pop(key, None)
-        is_tpdo = pdo_map in self._node.tpdo.map.values()
+        is_tpdo = pdo_map in self._tpdo_maps
         if is_tpdo and pdo_map.enabled:
             network.unsubscribe(pdo_map.cob_id, pdo_map.on_message)
         if not is_tpdo and self._on_rpdo not in pdo_map.callbacks:
@@ -158,15 +161,16 @@ class ProcessData:
             raise SdoAbortedError(ABORT_NOT_MAPPABLE)
 
     # --- reception -----------------------------------------------------------------
-    def receive(self, pdo_map: PdoMap) -> None:
-        """Apply a received RPDO now (event driven) or keep it for the next SYNC."""
+    def receive(self, pdo_map: PdoMap) -> bool:
+        """Apply a received RPDO now (event driven: True) or keep it for the next SYNC (False)."""
         if len(pdo_map.data) * 8 < pdo_map.length:
             self._on_length_error()
-            return
+            return False
         if pdo_map.trans_type is not None and pdo_map.trans_type <= 240:
             self._pending_rpdo[id(pdo_map)] = bytes(pdo_map.data)
-        else:
-            self._write_mapped(pdo_map)
+            return False
+        self._write_mapped(pdo_map)
+        return True
 
     def _write_mapped(self, pdo_map: PdoMap) -> None:
         for variable in pdo_map.map:
@@ -174,7 +178,7 @@ class ProcessData:
 
     def apply_synchronous_rpdos(self) -> None:
         """At a SYNC: write the synchronous RPDOs received during the last cycle."""
-        for pdo_map in self._node.rpdo.map.values():
+        for pdo_map in self._rpdo_maps:
             data = self._pending_rpdo.pop(id(pdo_map), None)
             if data is not None:
                 pdo_map.data = bytearray(data)
@@ -188,7 +192,7 @@ class ProcessData:
 
     def transmit_on_sync(self) -> None:
         """At a SYNC: send the synchronous TPDOs that are due (types 0 and 1..240)."""
-        for pdo_map in self._node.tpdo.map.values():
+        for pdo_map in self._tpdo_maps:
             if not pdo_map.enabled or pdo_map.trans_type is None or pdo_map.trans_type > 240:
                 continue
             key = id(pdo_map)
@@ -205,7 +209,7 @@ class ProcessData:
 
     def transmit_changed(self) -> None:
         """Send the event-driven TPDOs (types 254, 255) whose data changed."""
-        for pdo_map in self._node.tpdo.map.values():
+        for pdo_map in self._tpdo_maps:
             if not pdo_map.enabled or pdo_map.trans_type is None or pdo_map.trans_type < 254:
                 continue
             key = id(pdo_map)

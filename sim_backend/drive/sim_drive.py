@@ -105,6 +105,7 @@ class SimDrive:
         self.sdo_silent = False
         self.error_frames_active = False
         self._network: canopen.Network | None = None
+        self._applying_rpdo = False   # publish once after an RPDO's objects, not after each (_on_written)
 
     # --- public face -----------------------------------------------------------------
     @property
@@ -221,7 +222,13 @@ class SimDrive:
     def _on_rpdo(self, pdo_map: PdoMap) -> None:
         with self._lock:
             if self._listening() and self.node.nmt.state_code == OPERATIONAL:
-                self._process_data.receive(pdo_map)
+                self._applying_rpdo = True
+                try:
+                    applied = self._process_data.receive(pdo_map)
+                finally:
+                    self._applying_rpdo = False
+                if applied:
+                    self._publish()
 
     def _on_sync(self, can_id: int, data: bytearray, timestamp: float) -> None:
         """CiA 301 SYNC: apply synchronous RPDOs, sample and send TPDOs, then run one cycle."""
@@ -230,7 +237,11 @@ class SimDrive:
                 return
             operational = self.node.nmt.state_code == OPERATIONAL
             if operational:
-                self._process_data.apply_synchronous_rpdos()
+                self._applying_rpdo = True
+                try:
+                    self._process_data.apply_synchronous_rpdos()
+                finally:
+                    self._applying_rpdo = False
             self._publish()
             if operational:
                 self._process_data.transmit_on_sync()
@@ -360,7 +371,9 @@ class SimDrive:
             raise SdoAbortedError(ABORT_VALUE_RANGE)
 
     def _on_written(self, index: int, subindex: int) -> None:
-        """A value was stored by an SDO download or an RPDO."""
+        """A value was stored by an SDO download or an RPDO. An SDO download's effect is published at
+        once; an RPDO's once all its objects are written (`_on_rpdo`, and `_on_sync` for synchronous
+        RPDOs): the same objects and event TPDOs as after each object, for a fraction of the work."""
         if index == 0x6040:
             self._on_controlword(self.node.value(0x6040))
         elif index == 0x6060:
@@ -369,7 +382,8 @@ class SimDrive:
             self._watch_master()
         elif is_pdo_parameter(index):
             self._process_data.on_config_written(index)
-        self._publish()
+        if not self._applying_rpdo:
+            self._publish()
 
     # --- CiA 402 ----------------------------------------------------------------------
     def _mode(self) -> int:
