@@ -158,6 +158,11 @@ def test_a_configuration_whose_bus_and_tracker_name_the_served_testbed_runs_on_i
     assert served.process.poll() is None and not (runtime / "crest").exists()   # it joined, started nothing
     log = read_log(log_path)
     assert len(log) > 20 and np.isfinite(log.tip_mm).all(axis=1).sum() > 5      # tips from the served tracker
+    # the CAN recording holds the host's own SYNCs and RPDOs as sent (a second handle on a hardware
+    # bus would never see them) and the drives' TPDOs as received
+    frames = list(can.LogReader(log_path.with_suffix(".blf")))
+    assert {0x80, *(0x200 + n for n in NODE_IDS)} <= {f.arbitration_id for f in frames if not f.is_rx}
+    assert {0x180 + n for n in NODE_IDS} <= {f.arbitration_id for f in frames if f.is_rx}
 
 
 def thread_cpu_sets(pid: int) -> set[frozenset[int]]:
