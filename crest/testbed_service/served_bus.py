@@ -11,6 +11,7 @@ it would on hardware; `lost` keeps what ended the connection.
 from __future__ import annotations
 
 import threading
+
 import can
 from can_remote.client import RemoteBus
 from can_remote.websocket import WebsocketClosed

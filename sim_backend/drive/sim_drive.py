@@ -32,7 +32,9 @@ from the runner, the plant's setters) take the drive's lock.
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 from pathlib import Path
+from typing import TypeVar
 
 import can
 import canopen
@@ -55,6 +57,8 @@ from sim_backend.drive.profile_position import RELATIVE_BIT, MotionProfile, Prof
 from sim_backend.drive.servo_axis import ServoAxis
 from sim_backend.drive.setpoint_generator import SetpointGenerator
 from sim_backend.faults import FaultKind
+
+T = TypeVar("T")
 
 MODE_NONE = 0
 MODE_PROFILE_POSITION = 1
@@ -222,13 +226,17 @@ class SimDrive:
     def _on_rpdo(self, pdo_map: PdoMap) -> None:
         with self._lock:
             if self._listening() and self.node.nmt.state_code == OPERATIONAL:
-                self._applying_rpdo = True
-                try:
-                    applied = self._process_data.receive(pdo_map)
-                finally:
-                    self._applying_rpdo = False
-                if applied:
+                if self._unpublished(lambda: self._process_data.receive(pdo_map)):
                     self._publish()
+
+    def _unpublished(self, apply_rpdos: Callable[[], T]) -> T:
+        """`apply_rpdos()` (writes of RPDO objects) with `_on_written`'s publishing held back: the
+        caller publishes once, after all of them."""
+        self._applying_rpdo = True
+        try:
+            return apply_rpdos()
+        finally:
+            self._applying_rpdo = False
 
     def _on_sync(self, can_id: int, data: bytearray, timestamp: float) -> None:
         """CiA 301 SYNC: apply synchronous RPDOs, sample and send TPDOs, then run one cycle."""
@@ -237,11 +245,7 @@ class SimDrive:
                 return
             operational = self.node.nmt.state_code == OPERATIONAL
             if operational:
-                self._applying_rpdo = True
-                try:
-                    self._process_data.apply_synchronous_rpdos()
-                finally:
-                    self._applying_rpdo = False
+                self._unpublished(self._process_data.apply_synchronous_rpdos)
             self._publish()
             if operational:
                 self._process_data.transmit_on_sync()
