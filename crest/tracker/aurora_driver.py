@@ -21,6 +21,7 @@ from __future__ import annotations
 import enum
 import logging
 import string
+import termios
 import threading
 import time
 from collections.abc import Callable
@@ -271,8 +272,12 @@ class AuroraDriver:
         if self._stop.is_set() and command != "TSTOP:":
             raise TrackerLinkError(f"{command} not sent: the driver is stopping")
         port = self._serial
-        port.timeout = timeout_s
-        port.reset_input_buffer()  # leftovers of an earlier failed exchange
+        if port.timeout != timeout_s:
+            port.timeout = timeout_s  # reconfigures the line (tcsetattr): only on a change
+        try:
+            port.reset_input_buffer()  # leftovers of an earlier failed exchange
+        except termios.error as exc:  # pyserial lets tcflush's error through: the line has gone (EIO)
+            raise TrackerLinkError(f"{command} not sent: the serial line is gone ({exc})") from exc
         port.write(reply.with_crc(command))
         raw = _read_reply(port, timeout_s)
         if not raw.endswith(b"\r"):

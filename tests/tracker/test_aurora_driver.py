@@ -129,6 +129,27 @@ def test_disconnect_is_detected_and_the_link_comes_back(sim, driver):
         TrackerState.CONNECTING, TrackerState.TRACKING, TrackerState.RECONNECTING, TrackerState.TRACKING]
 
 
+def test_a_tracker_that_vanishes_between_polls_is_a_lost_link_not_a_crash(tip, monkeypatch):
+    """The served testbed killed with -9 takes the tracker's pseudo-terminal with it, most often while
+    the driver waits for its next poll: the next exchange fails on the dead line (EIO), which is a lost
+    link to reconnect, never an exception that kills the polling thread."""
+    crashed = []
+    monkeypatch.setattr(threading, "excepthook", crashed.append)
+    sim = SimTracker(tip, seed=5).start()
+    states = []
+    tracker = AuroraDriver(sim.port_name, on_state=lambda state, reason: states.append((state, reason)),
+                           **{**FAST, "rate_hz": 5.0}).start()
+    try:
+        tracker.wait_next(WAIT_S)
+        sim.stop()
+        assert tracker.wait_state(TrackerState.RECONNECTING, WAIT_S)
+        reason = next(reason for seen, reason in states if seen is TrackerState.RECONNECTING)
+        assert "TX:0001" in reason and "Input/output error" in reason, reason
+    finally:
+        tracker.stop()
+    assert crashed == [] and tracker.state is TrackerState.STOPPED
+
+
 def test_stop_sends_tstop_and_closes(sim, driver):
     driver.wait_next(WAIT_S)
     driver.stop()
