@@ -277,7 +277,7 @@ class AuroraDriver:
         try:
             port.reset_input_buffer()  # leftovers of an earlier failed exchange
         except termios.error as exc:  # pyserial lets tcflush's error through: the line has gone (EIO)
-            raise TrackerLinkError(f"{command} not sent: the serial line is gone ({exc})") from exc
+            raise serial.SerialException(f"{command} not sent: the serial line is gone ({exc})") from exc
         port.write(reply.with_crc(command))
         raw = _read_reply(port, timeout_s)
         if not raw.endswith(b"\r"):

@@ -139,12 +139,14 @@ def test_a_tracker_that_vanishes_between_polls_is_a_lost_link_not_a_crash(tip, m
     states = []
     tracker = AuroraDriver(sim.port_name, on_state=lambda state, reason: states.append((state, reason)),
                            **{**FAST, "rate_hz": 5.0}).start()
+    tracker.states_seen = states
     try:
         tracker.wait_next(WAIT_S)
         sim.stop()
         assert tracker.wait_state(TrackerState.RECONNECTING, WAIT_S)
-        reason = next(reason for seen, reason in states if seen is TrackerState.RECONNECTING)
+        reason = first_reason(tracker, TrackerState.RECONNECTING)
         assert "TX:0001" in reason and "Input/output error" in reason, reason
+        assert tracker.stats().timeouts == 0     # a line that is gone is a serial error, not a reply that was late
     finally:
         tracker.stop()
     assert crashed == [] and tracker.state is TrackerState.STOPPED
