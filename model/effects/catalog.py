@@ -44,8 +44,9 @@ EFFECTS: dict[str, CandidateEffect] = {e.id: e for e in (
                 "axis, which the testbed holds horizontal (g in the base x-y plane, g_z = 0)",
         param_names=("g_x_m_s2", "g_y_m_s2"), typical=(0.0, -9.81),
         lower=(-20.0, -20.0), upper=(20.0, 20.0),   # up to 2 g: a fluid-filled catheter weighs more
-        signature="a fixed-direction offset that grows with free length, present even at zero load",
-        signature_region="zero load",
+        signature="a fixed-direction offset that grows with free length, present at every articulation "
+                  "(zero load included): adding it removes error in every region of the motion",
+        signature_region="every region",
         apply=lambda t, v: t.replace(gravity_m_s2=(v[0], v[1], 0.0))),
     CandidateEffect(
         id="torsion",
@@ -96,7 +97,8 @@ EFFECTS: dict[str, CandidateEffect] = {e.id: e for e in (
         signature="the tip trails fast motion (error along the motion, growing with speed) and keeps creeping "
                   "without overshoot for ~tau after each stop; slow motion and settled holds agree",
         signature_region="fast",
-        apply=lambda t, v: t.replace(drive_creep_mm_per_n=v[0], drive_creep_time_s=v[1])),
+        apply=lambda t, v: t.replace(drive_creep_mm_per_n=v[0], drive_creep_time_s=v[1]),
+        reduces_to="tendon_elasticity"),   # tau -> 0: s = c*T_drive, an elastic drive line
 )}
 
 

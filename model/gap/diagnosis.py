@@ -7,9 +7,10 @@
    held-out score (`candidates`); the best is chosen only if it removes more than noise can
    explain, both against the baseline and against its own ablation (the same fit with the
    effect switched off), else the verdict is `none` with a description of the unexplained
-   residual. A second effect is added by greedy forward selection among the next best candidates
-   found on their own, again only if the pair is meaningful against the control: the chosen
-   effect refitted alone with the same budget.
+   residual. Where the best found effect reduces to a simpler one that is found too, and is not
+   meaningfully better, the simpler one leads (`nested_candidates`). A second effect is added by
+   greedy forward selection among the next best candidates found on their own, again only if the
+   pair is meaningful against the control: the chosen effect refitted alone with the same budget.
 4. How far: held-out RMSE before and after, shrink overall and per region, and how the base
    parameters moved when the effect was added.
 The result is a plain, JSON-able dict (see `diagnose`).
@@ -34,6 +35,7 @@ from model.gap.finite_json import finite_tree
 from model.gap.fit_pool import fit_pool, one_blas_thread
 from model.gap.free_parameters import base_values
 from model.gap.holdout_split import HoldoutSplit, split_holdout
+from model.gap.nested_candidates import simplest_sufficient
 from model.gap.noise import tracker_noise_mm
 from model.gap.plausibility import hold_drift_reasons, range_reasons, signature_concentration, signature_reasons
 from model.gap.recording import Recording, RecordingError
@@ -174,7 +176,11 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
 
     chosen: list[CandidateResult] = []
     pairs: list[CandidateResult] = []
-    eligible = [r for r in singles if not rejections(r)]
+    found_singles = [r for r in singles if not rejections(r)]
+    eligible = simplest_sufficient(found_singles, noise)
+    if eligible and eligible[0] is not found_singles[0]:
+        say(f"{eligible[0].effects[0]} leads: {found_singles[0].effects[0]}, which reduces to it, removes no more "
+            "error than noise and fitting freedom explain")
     if eligible and settings.pair_candidates == 0:
         chosen = [eligible[0]]
     elif eligible:

@@ -26,16 +26,21 @@ Two checks, each giving a reason when it fails (a fit that passes both has no re
        C_R = (sum_{t in R} g_t / sum_t g_t) / (|R| / n),
 
    must reach MIN_SIGNATURE_CONCENTRATION: an effect that removes error mostly elsewhere (a
-   gravity fit that improves only the strongly bent samples, not the straight ones where sag
-   is present at zero load) does not explain the residual the way its physics would. A region
-   with fewer than MIN_REGION_SAMPLES samples cannot tell and passes.
-   An effect whose signature is everywhere (EVERY_REGION: a constant bias) must not make any
-   region worse by more than noise explains (`worse_regions`), but need not concentrate in any:
-   the baseline's tendon zeros absorb part of a constant tip offset at zero load (a slight bend
-   under a little pretension) and none of it where the catheter is bent, so a true offset's gain
-   lies mostly at high articulation (0.09-0.36 of its share at zero load on three logs with a
-   true offset, which the zero-load rule rejected). A fit that makes any region worse, by more
-   than noise and fitting freedom explain, absorbs something else.
+   backlash fit that improves only the slow samples, not those just after a reversal) does not
+   explain the residual the way its physics would. A region with fewer than MIN_REGION_SAMPLES
+   samples cannot tell and passes.
+   An effect whose signature is everywhere (EVERY_REGION: a constant bias, or a sag under the
+   catheter's weight, present at every articulation) must not make any region worse by more
+   than noise explains (`worse_regions`), but need not concentrate in any: the baseline's tendon
+   zeros absorb part of a constant tip offset or sag at zero load (a slight bend under a little
+   pretension) and none of it where the catheter is bent, so a true offset's gain lies mostly at
+   high articulation (0.09-0.36 of its share at zero load on three logs with a true offset,
+   which the zero-load rule rejected), and so does a true gravity's: of six blind gravities the
+   zero-load rule alone rejected (re-recorded, 2026-11-28), the four this rule finds had 0.04-0.47
+   (rod seeds 57, 66 and 68, dahl 61); dahl 60 and 62 make zero load worse (0.43 -> 0.62 and
+   0.34 -> 0.39 mm) and are still rejected.
+   A fit that makes any region worse, by more than noise and fitting freedom explain, absorbs
+   something else.
 3. Holds: over each static hold H (a run of at least MIN_HOLD_SAMPLES consecutive "static" samples
    of one recording, all in the selection half) the error's drift d_H = e_last - e_first is the
    model's motion during the hold less the tip's. Its RMS over the holds,
