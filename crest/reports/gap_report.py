@@ -114,6 +114,8 @@ def markdown(result: dict) -> str:
              + (f"{floor:.3f} mm" if floor is not None else "unknown (no static holds in the logs)")]
     for effect_id, params in verdict["params"].items():
         lines.append(f"- {effect_id}: " + ", ".join(f"{k} = {v:.4g}" for k, v in params.items()))
+    lines += [f"- named before {row['effect']}, which scored higher: {row['reason']}"
+              for row in verdict.get("simpler_than", [])]
     lines += ["", "Held-out tip RMSE per recording (all evaluated rows), against calibrated constant curvature:", "",
               "| recording | calibrated CC | calibrated Dahl | Dahl + verdict |", "|---|---|---|---|"]
     lines += [f"| {row['recording']} | {row['constant_curvature_mm']:.3f} mm | {row['baseline_mm']:.3f} mm | "

@@ -178,9 +178,12 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
     pairs: list[CandidateResult] = []
     found_singles = [r for r in singles if not rejections(r)]
     eligible = simplest_sufficient(found_singles, noise)
+    simpler_than = []   # the richer found effect that scored higher but gave way (nested_candidates)
     if eligible and eligible[0] is not found_singles[0]:
-        say(f"{eligible[0].effects[0]} leads: {found_singles[0].effects[0]}, which reduces to it, removes no more "
-            "error than noise and fitting freedom explain")
+        simpler_than = [{"effect": found_singles[0].effects[0],
+                         "reason": f"{found_singles[0].effects[0]} reduces to {eligible[0].effects[0]} and removes no "
+                                   "more error than noise and fitting freedom explain"}]
+        say(f"{eligible[0].effects[0]} leads: {simpler_than[0]['reason']}")
     if eligible and settings.pair_candidates == 0:
         chosen = [eligible[0]]
     elif eligible:
@@ -235,6 +238,7 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
         "base_drift": drift,
         "residual_concentrated": [row["region"] for row in concentrated(after_where)],
         "model_form_rms_mm": model_form_rms_mm(after_rmse, noise),
+        "simpler_than": simpler_than if final else [],
         "rejected": [] if final else [{"effect": r.effects[0], "reasons": rejections(r)} for r in singles[:3]],
         "fit": after_fit.as_dict(),
     }

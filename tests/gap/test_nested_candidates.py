@@ -1,8 +1,12 @@
 """Between a found effect and a simpler one it reduces to, the simpler one leads unless the richer one
 removes more error than noise and fitting freedom explain (model/gap/nested_candidates.py)."""
+import json
+
+from crest.reports.gap_report import markdown
 from model.effects import EFFECTS
 from model.gap.candidates import CandidateResult
 from model.gap.nested_candidates import simplest_sufficient
+from tests.gap.test_sampling import diagnoses
 
 
 def found(effect_id: str, selection_rmse_mm: float, score: float) -> CandidateResult:
@@ -35,3 +39,14 @@ def test_every_reduction_names_a_catalog_effect_with_fewer_parameters():
     for effect in EFFECTS.values():
         if effect.reduces_to:
             assert len(EFFECTS[effect.reduces_to].param_names) < len(effect.param_names), effect.id
+
+
+def test_the_verdict_and_the_report_say_which_richer_effect_gave_way():
+    """A real diagnosis gives the field (empty: no nested pair was found); the report names the richer
+    effect and why it gave way when there is one."""
+    result = json.loads(json.dumps(diagnoses()[0]))
+    assert result["verdict"]["simpler_than"] == []
+    result["verdict"]["simpler_than"] = [{"effect": "rate_lag", "reason": "rate_lag reduces to tendon_elasticity "
+                                          "and removes no more error than noise and fitting freedom explain"}]
+    assert ("- named before rate_lag, which scored higher: rate_lag reduces to tendon_elasticity and removes no more "
+            "error than noise and fitting freedom explain") in markdown(result)
