@@ -10,10 +10,16 @@ is the loop's whole work per cycle (drives, plant, bus, controller) and any time
 thread takes from it shows in full; in real time (``realtime=True``) the loop waits for each SYNC
 period, and the view would show as cycles later than the nominal period. The tracker is left
 out: in simulated time its wall-clock frames would pace the loop.
+
+With the browser, a second thread also times how long the page takes to answer a trivial script
+(selenium's ``execute_script("return 1")``, every PAGE_PROBE_S during the run): the page's own
+thread runs that script after whatever it has queued, so this is how late an E-STOP click would be
+handled. A page that falls behind the frames sent to it answers seconds late (paint_handshake.py).
 """
 from __future__ import annotations
 
 import contextlib
+import threading
 import time
 
 import numpy as np
@@ -30,6 +36,7 @@ from model import CatheterParams
 
 CIRCLE_PERIOD_S = 8.0
 PAGE_SETTLE_S = 2.0          # the page's first load and render, before the measured run starts
+PAGE_PROBE_S = 0.5           # between two timings of the page's answer
 
 
 def control_loop_with_and_without_view(duration_s: float = 20.0, controller_name: str = "dahl", *,
@@ -66,8 +73,34 @@ def _cycle_times(duration_s: float, controller_name: str, realtime: bool, *, vie
             session.testbed.hold(PAGE_SETTLE_S)
         on_cycle = shown.follow("bench circle", trajectory.tip_mm, len(trajectory),
                                 lambda _done: stamps.append(time.perf_counter()))
+        answers_ms: list[float] = []
+        if browser:
+            stack.enter_context(_timing_page_answers(driver, answers_ms))
         run_with_controller(session, trajectory, controller, on_cycle=on_cycle)
     cycle_ms = 1e3 * np.diff(stamps)
-    return {"cycles": len(stamps), "sync_period_ms": 1e3 * period_s,
-            "median_ms": float(np.median(cycle_ms)), "p99_ms": float(np.percentile(cycle_ms, 99)),
-            "longest_ms": float(cycle_ms.max()), "late_cycles": int(np.sum(cycle_ms > 1.5e3 * period_s))}
+    result = {"cycles": len(stamps), "sync_period_ms": 1e3 * period_s,
+              "median_ms": float(np.median(cycle_ms)), "p99_ms": float(np.percentile(cycle_ms, 99)),
+              "longest_ms": float(cycle_ms.max()), "late_cycles": int(np.sum(cycle_ms > 1.5e3 * period_s))}
+    if answers_ms:
+        result["page_answer_ms"] = {"count": len(answers_ms), "median": float(np.median(answers_ms)),
+                                    "longest": float(max(answers_ms))}
+    return result
+
+
+@contextlib.contextmanager
+def _timing_page_answers(driver, answers_ms: list[float]):
+    """Time ``execute_script("return 1")`` every PAGE_PROBE_S in a thread of its own while the block runs."""
+    done = threading.Event()
+
+    def probe() -> None:
+        while not done.wait(PAGE_PROBE_S):
+            start = time.perf_counter()
+            driver.execute_script("return 1")
+            answers_ms.append(1e3 * (time.perf_counter() - start))
+    thread = threading.Thread(target=probe, name="page-probe", daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        done.set()
+        thread.join()

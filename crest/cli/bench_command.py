@@ -190,6 +190,11 @@ def format_table(results: dict) -> str:
             rows.append((f"Control loop cycle ({r['clock']}), {label}",
                          f"median {c['median_ms']:.2f} ms, p99 {c['p99_ms']:.2f} ms, {c['late_cycles']} of "
                          f"{c['cycles']} over 1.5 SYNC periods", f"SYNC period {c['sync_period_ms']:g} ms", None))
+            if "page_answer_ms" in c:
+                a = c["page_answer_ms"]
+                rows.append((f"Live view page's answer to a script during that run ({a['count']} timings)",
+                             f"median {a['median']:.0f} ms, longest {a['longest']:.0f} ms",
+                             "well under a second (an E-STOP click waits as long)", None))
     lines = ["| measure | result | goal | met |", "|---|---|---|---|"]
     for name, value, goal, met in rows:
         lines.append(f"| {name} | {value} | {goal} | {'-' if met is None else ('yes' if met else 'NO')} |")
