@@ -108,12 +108,15 @@ class LiveView:
         self._pages += 1
 
         def update() -> None:
+            if not page.handshake.all_painted():     # the browser is still drawing the last frame
+                return
             page.show(self.state.frame())
             if self._final_version is not None and self.state.version >= self._final_version:
                 self._final_shown.set()
 
         doc.title = self._title
         doc.add_root(page.layout)
+        page.handshake.install(doc)
         update()
         doc.add_periodic_callback(update, int(1000 * SCREEN_PERIOD_S))
 

@@ -17,6 +17,7 @@ from bokeh.layouts import column, row
 from bokeh.models import Button, ColumnDataSource, Div, Range1d, Slider, Span
 from bokeh.plotting import figure
 
+from crest.view.paint_handshake import PaintHandshake
 from crest.view.view_frame import ViewFrame
 
 TENDON_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728")
@@ -36,6 +37,7 @@ class Page:
     def __init__(self, title: str, extent_mm: float, *, on_estop: Callable[[], str] | None = None,
                  timeline_s: tuple[float, float, Callable[[float], None]] | None = None) -> None:
         self._shown: ViewFrame | None = None
+        self.handshake = PaintHandshake()
         self.title = Div(text=f"<h2 style='margin:4px 0'>{html.escape(title)}</h2>", name="title")
         self.stop = Div(text="", name="stop", width=1100)
         self.status = Div(text="", name="status", width=1100)
@@ -69,7 +71,7 @@ class Page:
             self.slider.on_change("value_throttled", lambda _attr, _old, new: on_change(float(new)))
             controls = [self.slider]
         self.layout = column(self.title, *controls, self.stop, self.status, row(*projections),
-                             row(self.tension_plot, self.axes))
+                             row(self.tension_plot, self.axes), *self.handshake.models)
 
     def _projection(self, name: str, horizontal: str, vertical: str, extent_mm: float):
         plot = figure(title=f"{name} view ({horizontal}-{vertical}) [mm]", width=360, height=360, tools="",
@@ -111,6 +113,7 @@ class Page:
         self.stop.text = "" if frame.stop is None else (
             "<div style='background:#b00;color:white;font-size:18px;padding:8px'>"
             f"{html.escape(frame.stop.describe())}</div>")
+        self.handshake.sent()
 
 
     def _show_tensions(self, t_s: np.ndarray, tension_n: np.ndarray) -> None:

@@ -140,6 +140,46 @@ def test_page_shows_backbone_and_tensions_updating_during_the_run(live_run, live
     assert live_run.process.poll() is None, "the run must still be going"
 
 
+PROBE_JS = """
+window.crestProbe = [];
+const frame = Bokeh.documents[0].get_model_by_name("frame_sent");
+frame.connect(frame.properties.text.change, () => window.crestProbe.push("frame " + frame.text));
+function paint() { window.crestProbe.push("paint"); requestAnimationFrame(paint); }
+requestAnimationFrame(paint);
+"""
+
+BLOCK_JS = """
+const start = Date.now();
+while (Date.now() < start + 1000 * arguments[0]) {}
+window.crestProbe.push("unblocked");
+return [start, Date.now()];
+"""
+
+
+def test_a_page_too_busy_to_draw_gets_no_backlog_of_frames(live_run, live_page):
+    """A page that cannot keep up (here: its thread blocked for 3 s, 30 of the server's frame periods)
+    must not find a queue of frames when it can draw again: the server sends the next frame only
+    after the browser has painted the last (paint_handshake.py). Each frame carries its send time
+    (Unix ms; the browser's clock is the machine's), so the frames sent during the block are counted."""
+    browser = live_page
+    sent_and_painted = lambda: browser.execute_script(
+        "const docs = window.Bokeh ? Bokeh.documents : []; if (!docs.length) return null;"
+        " return [docs[0].get_model_by_name('frame_sent').text, docs[0].get_model_by_name('frame_painted').text];")
+    wait_for(lambda: (numbers := sent_and_painted()) and int(numbers[1].split()[0]) > 2, PAGE_TIMEOUT_S,
+             "the browser to acknowledge painted frames")
+    browser.execute_script(PROBE_JS)
+    block_start_ms, block_end_ms = browser.execute_script(BLOCK_JS, 3.0)
+    events = wait_for(lambda: (probe := browser.execute_script("return window.crestProbe;"))
+                      and sum(e.startswith("frame") for e in probe[probe.index("unblocked"):]) >= 3 and probe,
+                      PAGE_TIMEOUT_S, "three frames after the block")
+    frames = [(int(e.split()[1]), float(e.split()[2])) for e in events if e.startswith("frame")]
+    sent_while_blocked = [n for n, sent_ms in frames if block_start_ms < sent_ms < block_end_ms]
+    assert len(sent_while_blocked) <= 1, f"frames sent to a page that could not draw: {sent_while_blocked}"
+    numbers = [n for n, _ in frames]
+    assert numbers == sorted(numbers) and len(set(numbers)) == len(numbers)     # every frame is new
+    assert live_run.process.poll() is None, "the run must still be going"
+
+
 def test_estop_button_stops_the_run_with_its_cause_in_the_log(live_run, live_page):
     browser = live_page
     estop = wait_for(lambda: button(browser, "E-STOP"), PAGE_TIMEOUT_S, "the E-STOP button")
