@@ -38,7 +38,11 @@ Two checks, each giving a reason when it fails (a fit that passes both has no re
    which the zero-load rule rejected), and so does a true gravity's: of six blind gravities the
    zero-load rule alone rejected (re-recorded, 2026-11-28), the four this rule finds had 0.04-0.47
    (rod seeds 57, 66 and 68, dahl 61); dahl 60 and 62 make zero load worse (0.43 -> 0.62 and
-   0.34 -> 0.39 mm) and are still rejected.
+   0.34 -> 0.39 mm) and are still rejected. An elastic drive line, whose stretch grows with
+   tension, is the same case: the base fit (stiffness, tendon zeros) takes up the part that grows
+   with tension, and in the blind benchmark's stored results the elastic-line fits that the
+   high-tension rule alone rejected were true elastic lines six times of seven (dahl seeds 50-64,
+   high-tension concentrations -0.05 to 0.41), never a clean or out-of-catalog case.
    A fit that makes any region worse, by more than noise and fitting freedom explain, absorbs
    something else.
 3. Holds: over each static hold H (a run of at least MIN_HOLD_SAMPLES consecutive "static" samples

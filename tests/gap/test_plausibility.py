@@ -55,6 +55,23 @@ def test_gravity_need_not_concentrate_at_zero_load_but_must_not_make_it_worse():
     assert concentration < 0.0 and reasons and "zero load" in reasons[0]
 
 
+def test_an_elastic_line_need_not_concentrate_at_high_tension_but_must_not_make_a_region_worse():
+    """The base fit takes up the part of a drive line's stretch that grows with tension, so a true
+    elastic line's gain may lie at low tension (dahl seed 64: 0.41 of its share at high tension,
+    oracle 0.61, rejected by the old high-tension rule). It is found; one that makes the
+    low-tension samples worse is not an elastic line."""
+    f = features([30.0] * 100)      # features() gives the tension, 1-5 N, rising over the samples
+    before = np.ones((100, 3))
+    after_low_tension_only = before.copy()
+    after_low_tension_only[:50] *= 0.5
+    reasons, concentration = signature_reasons("tendon_elasticity", f, before, after_low_tension_only, noise_mm=0.1)
+    assert reasons == [] and concentration == 0.0
+    worse_at_high_tension = after_low_tension_only.copy()
+    worse_at_high_tension[50:] *= 1.2
+    reasons, _ = signature_reasons("tendon_elasticity", f, before, worse_at_high_tension, noise_mm=0.1)
+    assert reasons and "high tension" in reasons[0]
+
+
 def test_precurvature_that_only_improves_bent_samples_does_not_match_its_signature():
     """A rest bend shows when the catheter is straight: a 'precurvature' fit whose gain lies only
     where the catheter is bent absorbs something else."""
