@@ -49,11 +49,6 @@ def _effect_help() -> str:
             f"(repeatable; unset parameters take their typical value). IDs (parameters): {effects}")
 
 
-def add_debug_option(parser: argparse.ArgumentParser, default=argparse.SUPPRESS) -> None:
-    """--debug, accepted before and after the command (a subcommand's copy must not reset the main one)."""
-    parser.add_argument("--debug", action="store_true", default=default, help="show Python tracebacks on errors")
-
-
 def add_overwrite_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--overwrite", action="store_true", help="replace output files that already exist")
 

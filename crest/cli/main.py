@@ -8,8 +8,8 @@ import argparse
 import importlib
 import sys
 
-from crest.cli.common_options import add_debug_option
 from crest.cli.compile_notice import announce_compiles
+from crest.cli.debug_option import add_debug_option
 from crest.cli.library_logging import route_library_logging
 from crest.cli.stop_signals import install_stop_signals
 from crest.config import ConfigError

@@ -10,7 +10,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from crest.cli.common_options import add_debug_option, parse_effect
+from crest.cli.common_options import parse_effect
+from crest.cli.debug_option import add_debug_option
 from crest.config import load_testbed_config
 from crest.driver import Terminated
 from crest.exit_codes import ExitCode

@@ -76,3 +76,14 @@ def test_a_cached_kernel_starts_without_the_notice():
     result = crest("status")
     assert result.returncode == 0, result.stderr
     assert COMPILE_NOTICE not in result.stderr
+
+
+def test_estop_starts_without_loading_the_model():
+    """`crest estop` must act at once: it never runs the model, so it never pays for importing numba and
+    the model's kernels (more than half a second) before it reaches the drives."""
+    result = subprocess.run([sys.executable, "-X", "importtime", "-m", "crest.cli.main", "estop"], cwd=REPO,
+                            capture_output=True, text=True, timeout=240)
+    imported = {line.split("|")[-1].strip() for line in result.stderr.splitlines() if line.startswith("import time:")}
+    assert "crest.driver" in imported and "crest.backend" in imported     # what it does need
+    assert not {"numba", "model", "control", "scipy"} & imported, sorted({"numba", "model", "control", "scipy"} & imported)
+    assert "nothing was stopped: no virtual testbed is running" in result.stderr     # and it still says what it did
