@@ -1,0 +1,38 @@
+"""`crest fit --fit-rate-hz`: the logs are fitted at the rate asked for, over as many seconds of log as at
+the default rate, and a rate that is not a number > 0 is refused before any log is read."""
+import json
+
+import pytest
+
+from cli_runner import crest
+from crest.exit_codes import ExitCode
+from crest.log import read_log
+
+SETPOINTS = "t,tendon_cmd_1,tendon_cmd_2,tendon_cmd_3,tendon_cmd_4,insertion_cmd\n0,0,0,0,0,22\n3,1.0,0,-1.0,0,22\n"
+
+
+def test_a_fit_at_50_hz_uses_every_other_row_of_a_100_hz_log(tmp_path):
+    setpoints, log = tmp_path / "setpoints.csv", tmp_path / "run.csv"
+    setpoints.write_text(SETPOINTS)
+    recorded = crest("run", str(setpoints), "--fast", "--record", str(log))
+    assert recorded.returncode == 0, recorded.stderr
+    rows = len(read_log(log))
+    result = crest("fit", str(log), "--dynamics", "off", "--fit-rate-hz", "50", "--out", str(tmp_path / "fit.toml"),
+                   "--json", str(tmp_path / "fit.json"))
+    assert result.returncode == 0, result.stderr
+    sampling = json.loads((tmp_path / "fit.json").read_text())["sampling"]
+    assert sampling["fit_rate_hz"] == 50.0
+    assert sampling["max_fit_samples"] == 12000                 # 2400 at 10 Hz: the same 240 s of log
+    (train,) = sampling["train"]
+    assert train["rows"] == rows and train["decimation"] == 2   # the 100 Hz SYNC's rows, every other one
+    assert train["rows_used"] == (rows + 1) // 2
+    assert "decimated to about 50 Hz" in (tmp_path / "fit.toml").read_text()
+
+
+@pytest.mark.parametrize("rate", ["0", "-10", "nan", "fast"])
+def test_a_fit_rate_that_is_not_a_positive_number_is_refused_before_any_log_is_read(tmp_path, rate):
+    result = crest("fit", str(tmp_path / "missing.csv"), "--fit-rate-hz", rate, "--out", str(tmp_path / "fit.toml"))
+    assert result.returncode == ExitCode.USAGE, result.stderr
+    assert f"--fit-rate-hz: expected a number > 0, got '{rate}'" in result.stderr
+    assert "no such file" not in result.stderr and "Traceback" not in result.stderr
+    assert not (tmp_path / "fit.toml").exists()
