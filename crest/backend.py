@@ -73,6 +73,13 @@ class Backend:
         finally:
             self.bus.untap(listener.on_message_received)
 
+    def tracker_port_alive(self) -> bool:
+        """May the tracker's port be opened again after its link was lost? A hardware port, yes: an
+        adapter plugged in again comes back under its name. A served testbed's pseudo-terminal only while
+        that testbed's bus is connected: once its process has ended, the terminal's number may belong
+        to the next testbed that starts."""
+        return self.served is None or self.bus.inner.lost is None
+
     def start_fault_clock(self) -> None:
         """The virtual testbed's --fault times count from now (the start of the run's motion):
         the testbed in this process starts its clock; one this process started hears it on the

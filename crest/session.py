@@ -92,7 +92,8 @@ def open_session(options: SessionOptions = SessionOptions()) -> Iterator[Session
             # in simulated time the feed asks for each frame (one per tracker period of simulated time)
             rate_hz = options.tracker_rate_hz if options.realtime else None
             tracker = AuroraDriver(backend.tracker_port, baudrate=config.tracker.baudrate,
-                                   tool_port=config.tracker.tool_port, rate_hz=rate_hz)
+                                   tool_port=config.tracker.tool_port, rate_hz=rate_hz,
+                                   port_alive=backend.tracker_port_alive)
             tracker.start()
             stack.callback(tracker.stop)
         with testbed:

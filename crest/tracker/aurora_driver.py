@@ -13,7 +13,7 @@ demand, for a loop in simulated time that needs a frame per tracker period of it
 stamps each reply with time.monotonic() on arrival, checks its CRC and publishes a TipSample. A reply
 timeout, a serial error, an ERROR reply or ``max_bad_replies`` consecutive unreadable replies (bad CRC,
 bad widths) count as link loss: the port is closed and set-up is retried with exponential backoff
-until it succeeds or ``stop()`` is called.
+until it succeeds or ``stop()`` is called, or until ``port_alive`` says the port is gone for good.
 """
 
 from __future__ import annotations
@@ -106,12 +106,19 @@ class AuroraDriver:
         max_bad_replies: consecutive unreadable replies (bad CRC or format) that count as link loss.
         backoff_s: first wait before a reconnection attempt; doubles per failure up to ``max_backoff_s``.
         on_state: called from the driver thread with (state, reason) on every state change.
+        port_alive: asked before each reconnection attempt; False means the device behind ``port`` is
+            gone for good, and the driver stops (state STOPPED) instead of opening ``port`` again. A
+            virtual testbed's pseudo-terminal ends with its process, and the kernel may give its number
+            to the next testbed that starts: opened again, it would reach that testbed's tracker, which
+            would then answer two clients on one line. None: always try (a hardware port comes back
+            under its name when its adapter is plugged in again).
     """
 
     def __init__(self, port: str, *, baudrate: int = 115200, tool_port: str = "0A", rate_hz: float | None = 40.0,
                  reply_timeout_s: float = 0.2, setup_timeout_s: float = 3.0, max_bad_replies: int = 3,
                  backoff_s: float = 0.1, max_backoff_s: float = 2.0,
-                 on_state: Callable[[TrackerState, str], None] | None = None):
+                 on_state: Callable[[TrackerState, str], None] | None = None,
+                 port_alive: Callable[[], bool] | None = None):
         if baudrate not in COMM_BAUD_CODES:
             raise ValueError(f"[tracker].baudrate {baudrate} is not an Aurora rate; use one of "
                              f"{sorted(COMM_BAUD_CODES)}")
@@ -132,6 +139,7 @@ class AuroraDriver:
         self.backoff_s = backoff_s
         self.max_backoff_s = max_backoff_s
         self.on_state = on_state
+        self._port_alive = port_alive or (lambda: True)
         self._serial: serial.Serial | None = None
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -305,6 +313,8 @@ class AuroraDriver:
                 self._count(timeouts=isinstance(exc, TrackerLinkError))
                 self._set_state(TrackerState.RECONNECTING, f"link lost: {exc}")
                 self._reconnect()
+                if self._serial is None:
+                    return  # the port is gone for good, or stop() was called
 
     def _poll(self) -> None:
         """Poll TX until the link is lost (raises) or stop is requested: at rate_hz, or on demand once per
@@ -355,6 +365,10 @@ class AuroraDriver:
     def _reconnect(self) -> None:
         wait_s = self.backoff_s
         while not self._stop.wait(wait_s):
+            if not self._port_alive():
+                self.last_error = f"{self.port} is gone for good (its testbed has ended): not opened again"
+                self._set_state(TrackerState.STOPPED, self.last_error)
+                return
             try:
                 self._connect()
             except _LINK_ERRORS as exc:

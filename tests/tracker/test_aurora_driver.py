@@ -4,6 +4,7 @@ import threading
 
 import numpy as np
 import pytest
+import serial
 
 from crest.tracker import AuroraDriver, TrackerLinkError, TrackerState
 from sim_backend.tracker import SimTracker
@@ -150,6 +151,36 @@ def test_a_tracker_that_vanishes_between_polls_is_a_lost_link_not_a_crash(tip, m
     finally:
         tracker.stop()
     assert crashed == [] and tracker.state is TrackerState.STOPPED
+
+
+def test_a_port_gone_for_good_is_not_opened_again(tip, monkeypatch):
+    """A served testbed killed with -9 takes its pseudo-terminal with it, and the kernel may give the
+    terminal's number to the next testbed that starts. Told that the port is gone for good, the driver
+    stops after the lost link instead of opening that number again, where another testbed's tracker
+    would answer two clients on one line."""
+    sim = SimTracker(tip, seed=5).start()
+    alive = threading.Event()
+    alive.set()
+    states = []
+    tracker = AuroraDriver(sim.port_name, port_alive=alive.is_set,
+                           on_state=lambda state, reason: states.append((state, reason)),
+                           **{**FAST, "rate_hz": 5.0}).start()
+    tracker.states_seen = states
+    opened = []
+    monkeypatch.setattr(serial, "Serial", lambda *args, **kwargs: opened.append(args))
+    try:
+        tracker.wait_next(WAIT_S)
+        alive.clear()
+        sim.stop()
+        assert tracker.wait_state(TrackerState.STOPPED, WAIT_S)
+        assert "gone for good" in first_reason(tracker, TrackerState.STOPPED)
+        assert [state for state, _ in states] == [TrackerState.CONNECTING, TrackerState.TRACKING,
+                                                  TrackerState.RECONNECTING, TrackerState.STOPPED]
+        assert opened == []
+        assert "gone for good" in tracker.last_error
+    finally:
+        tracker.stop()
+    assert tracker.state is TrackerState.STOPPED
 
 
 def test_stop_sends_tstop_and_closes(sim, driver):
