@@ -366,7 +366,7 @@ class AuroraDriver:
         wait_s = self.backoff_s
         while not self._stop.wait(wait_s):
             if not self._port_alive():
-                self.last_error = f"{self.port} is gone for good (its testbed has ended): not opened again"
+                self.last_error = f"{self.port} is gone for good: not opened again"
                 self._set_state(TrackerState.STOPPED, self.last_error)
                 return
             try:
