@@ -31,4 +31,3 @@ def test_a_joined_testbed_tracker_port_is_alive_until_the_testbed_process_is_kil
     finally:
         backend.close()
         stop(served.process)
-
