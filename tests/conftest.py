@@ -1,12 +1,36 @@
-"""Every test gets a runtime folder of its own for the served virtual testbed's state file.
+"""Session set-up shared by every test.
 
-A real-time crest command that finds no served testbed starts one (crest.testbed_service); the
+The numba kernels (the model's and the rod plant's) are compiled once, before pytest-xdist starts
+its workers (`pytest_configure`).
+
+Every test gets a runtime folder of its own for the served virtual testbed's state file. A
+real-time crest command that finds no served testbed starts one (crest.testbed_service); the
 state file in $XDG_RUNTIME_DIR/crest is how other processes find it. A folder per test keeps a
 test from joining a testbed another test (or the user's own `crest testbed serve`) left running.
 """
 from __future__ import annotations
 
 import pytest
+
+
+def pytest_configure(config):
+    """Compile the numba kernels here, in the one process that starts the xdist workers.
+
+    numba caches them on disk (model/jit.py), so the workers and every crest process a test starts
+    load them. On an empty cache (a clean checkout in CI) each of those processes would otherwise
+    compile its own copy at once, half a minute of a core each on an idle machine.
+    """
+    if hasattr(config, "workerinput"):      # an xdist worker: the controller has compiled them
+        return
+    from model import CatheterParams, ConstantCurvature, DahlCatheter
+    from sim_backend.plant.rod.rod_plant import RodPlant
+    params, pull_mm = CatheterParams.from_toml(), [0.5, 0.0, 0.0, 0.0]
+    catheter = DahlCatheter(params, n_elements=4)
+    catheter.move_to(pull_mm)
+    _ = catheter.backbone_mm
+    ConstantCurvature(params).tip_mm(pull_mm, 50.0)
+    ConstantCurvature(params).backbone_mm(pull_mm, 50.0)
+    RodPlant().step(0.01, pull_mm, 0.0)
 
 
 @pytest.fixture(autouse=True)
