@@ -18,10 +18,11 @@ def pytest_configure(config):
 
     numba caches them on disk (model/jit.py), so the workers and every crest process a test starts
     load them. On an empty cache (a clean checkout in CI) each of those processes would otherwise
-    compile its own copy at once, half a minute of a core each on an idle machine.
+    compile its own copy at once, half a minute of a core each on an idle machine. Without xdist
+    (`pytest` alone, or `-n 0`) nothing is compiled ahead: a test that needs no model does not wait.
     """
-    if hasattr(config, "workerinput"):      # an xdist worker: the controller has compiled them
-        return
+    if hasattr(config, "workerinput") or not config.getoption("numprocesses", default=None):
+        return      # an xdist worker (the controller has compiled them), or one process: it compiles as it goes
     from model import CatheterParams, ConstantCurvature, DahlCatheter
     from sim_backend.plant.rod.rod_plant import RodPlant
     params, pull_mm = CatheterParams.from_toml(), [0.5, 0.0, 0.0, 0.0]
