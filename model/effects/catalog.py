@@ -88,8 +88,9 @@ EFFECTS: dict[str, CandidateEffect] = {e.id: e for e in (
         physics="residual rest curvature of the unactuated catheter",
         param_names=("kappa_x_per_mm", "kappa_y_per_mm"), typical=(0.002, -0.001),
         lower=(-0.02, -0.02), upper=(0.02, 0.02),
-        signature="a bend at zero load in a fixed plane, scaling with free length",
-        signature_region="zero load",
+        signature="a bend in a fixed plane, scaling with free length, present at every articulation (zero "
+                  "load included): adding it removes error in every region of the motion",
+        signature_region="every region",
         apply=lambda t, v: t.replace(precurvature_per_mm=(v[0], v[1]))),
     CandidateEffect(
         id="rate_lag",

@@ -42,7 +42,12 @@ Two checks, each giving a reason when it fails (a fit that passes both has no re
    tension, is the same case: the base fit (stiffness, tendon zeros) takes up the part that grows
    with tension, and in the blind benchmark's stored results the elastic-line fits that the
    high-tension rule alone rejected were true elastic lines six times of seven (dahl seeds 50-64,
-   high-tension concentrations -0.05 to 0.41), never a clean or out-of-catalog case.
+   high-tension concentrations -0.05 to 0.41), never a clean or out-of-catalog case. A rest
+   curvature too: a slight differential pull of the baseline's tendon zeros bends the straight
+   catheter as a precurvature does, so a true precurvature's gain lies mostly where the catheter is
+   bent. Of six candidates over every stored blind result that the zero-load rule alone rejected,
+   four were true precurvatures (dahl seeds 50, 57 and 66, rod 57; concentrations -0.77 to 0.32),
+   dahl 66's fitted within 3 % of the truth.
    A fit that makes any region worse, by more than noise and fitting freedom explain, absorbs
    something else.
 3. Holds: over each static hold H (a run of at least MIN_HOLD_SAMPLES consecutive "static" samples

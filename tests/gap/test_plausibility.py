@@ -39,19 +39,23 @@ def test_a_lag_shorter_than_half_a_sample_is_an_elastic_drive_line_not_a_rate_la
     assert len(reasons) == 1 and "not resolved" in reasons[0] and "tendon_elasticity" in reasons[0]
 
 
-def test_gravity_need_not_concentrate_at_zero_load_but_must_not_make_it_worse():
-    """A sag is present at every articulation, and the baseline's tendon zeros take up part of it at
-    zero load: a true gravity's gain lies mostly where the catheter is bent (0.04 of it at zero load
-    on rod seed 68). It is found; a 'gravity' that makes the straight samples worse is not a sag."""
+@pytest.mark.parametrize("effect_id", ["gravity", "precurvature"])
+def test_a_bend_present_at_every_articulation_need_not_concentrate_at_zero_load_but_must_not_make_it_worse(
+        effect_id):
+    """A sag and a rest curvature are present at every articulation, and the baseline's tendon zeros
+    take up part of either at zero load (a slight differential pull bends the straight catheter
+    alike): a true gravity's or precurvature's gain lies mostly where the catheter is bent (0.04 of it
+    at zero load for rod seed 68's gravity, 0.32 for dahl seed 66's precurvature, fitted within 3 %
+    of the truth). It is found; one that makes the straight samples worse is not such a bend."""
     f = features([0.0] * 50 + [90.0] * 50)
     before = np.ones((100, 3))
     after_bent_only = before.copy()
     after_bent_only[50:] *= 0.5
-    reasons, concentration = signature_reasons("gravity", f, before, after_bent_only, noise_mm=0.1)
+    reasons, concentration = signature_reasons(effect_id, f, before, after_bent_only, noise_mm=0.1)
     assert reasons == [] and concentration == 0.0
     worse_when_straight = after_bent_only.copy()
     worse_when_straight[:50] *= 1.2
-    reasons, concentration = signature_reasons("gravity", f, before, worse_when_straight, noise_mm=0.1)
+    reasons, concentration = signature_reasons(effect_id, f, before, worse_when_straight, noise_mm=0.1)
     assert concentration < 0.0 and reasons and "zero load" in reasons[0]
 
 
@@ -70,19 +74,6 @@ def test_an_elastic_line_need_not_concentrate_at_high_tension_but_must_not_make_
     worse_at_high_tension[50:] *= 1.2
     reasons, _ = signature_reasons("tendon_elasticity", f, before, worse_at_high_tension, noise_mm=0.1)
     assert reasons and "high tension" in reasons[0]
-
-
-def test_precurvature_that_only_improves_bent_samples_does_not_match_its_signature():
-    """A rest bend shows when the catheter is straight: a 'precurvature' fit whose gain lies only
-    where the catheter is bent absorbs something else."""
-    f = features([0.0] * 50 + [90.0] * 50)
-    before = np.ones((100, 3))
-    after_bent_only = before.copy()
-    after_bent_only[50:] *= 0.5
-    reasons, concentration = signature_reasons("precurvature", f, before, after_bent_only)
-    assert concentration == 0.0 and reasons and "zero load" in reasons[0]
-    reasons, concentration = signature_reasons("precurvature", f, before, 0.5 * before)
-    assert reasons == [] and concentration >= MIN_SIGNATURE_CONCENTRATION
 
 
 def test_a_tracker_offset_need_not_concentrate_at_zero_load_but_must_help_everywhere():
