@@ -8,7 +8,8 @@ what each process got.
 
 Measured by the master as it sends the SYNCs (crest.driver.sync_timing; a second client on the
 bus would load the cycle it measures): the achieved rate, the period jitter (|period - nominal|,
-p50/p99) and missed cycles (a period longer than 1.5 nominal periods). From every frame the master
+p50/p99) and missed cycles (a period longer than 1.5 nominal periods), each counted by where its
+time went: the cycle's thread woke late, or the cycle before it overran. From every frame the master
 sends and receives (Backend.tapped): the bus load the traffic would put on a real bus. From the
 run itself: the cycles in which a drive's answer did not come within the master's reply time
 (crest.driver.sync_cycle: two periods, at least 20 ms, in real time; such a row lacks the answer),
@@ -128,6 +129,7 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
             "controller": controller_name, "cycles": timing["periods"],
             "achieved_rate_hz": timing["achieved_rate_hz"], "jitter_p50_ms": timing["jitter_p50_ms"],
             "jitter_p99_ms": timing["jitter_p99_ms"], "missed_cycles": timing["missed_cycles"],
+            "missed_woke_late": timing["missed_woke_late"], "missed_overran": timing["missed_overran"],
             "longest_period_ms": timing["longest_period_ms"],
             "bus_load_mean": float(load.mean_load), "bus_load_max": float(load.max_load),
             "bus_bitrate_bit_s": int(load.bitrate_bit_s), "cycles_over_bus_capacity": len(load.overloaded),

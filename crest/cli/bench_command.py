@@ -155,7 +155,8 @@ def format_table(results: dict) -> str:
                      f"{r['controller']} commands computed "
                      + ("ahead in a process of their own" if r["commands_in_own_process"] else "in the master"),
                      f"{r['achieved_rate_hz']:.0f} Hz, jitter p50 {r['jitter_p50_ms']:.2f} / p99 "
-                     f"{r['jitter_p99_ms']:.2f} ms, {r['missed_cycles']} missed, bus load "
+                     f"{r['jitter_p99_ms']:.2f} ms, {r['missed_cycles']} missed ({r['missed_woke_late']} woke late, "
+                     f"{r['missed_overran']} after an overrun), bus load "
                      f"{100 * r['bus_load_mean']:.0f}% of {r['bus_bitrate_bit_s'] / 1e6:g} Mbit/s"
                      + (f"; {r['cycles_held_for_a_command']} cycles held for a command not yet computed"
                         if r["cycles_held_for_a_command"] else "")

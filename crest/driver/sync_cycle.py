@@ -85,6 +85,7 @@ class SyncCycle:
         fresh TPDO1 per axis)."""
         if self.next_sync_s is None:
             self.next_sync_s = self._clock.now_s()
+        ready_in_time = self._clock.now_s() < self.next_sync_s
         self._clock.wait_until(self.next_sync_s)
         now_s = self._clock.now_s()
         self.next_sync_s = self._following_sync_s(now_s)
@@ -98,7 +99,7 @@ class SyncCycle:
                 axis.sent_target_counts = axis.target_counts
             self._network.send_message(SYNC_COB_ID, b"")
         sent_s = time.monotonic()
-        self.timing.sent(sent_s)
+        self.timing.sent(sent_s, ready_in_time)
         self.count += 1
         if meanwhile is not None:
             meanwhile()

@@ -4,7 +4,8 @@ from crest.cli.bench_command import format_table
 STACK = {"sync_rate_hz_nominal": 500.0, "duration_s": 60.0, "testbed": "its own process",
          "master_scheduling": "real-time (SCHED_FIFO, priority 20)", "testbed_scheduling": "real-time",
          "controller": "dahl", "commands_in_own_process": True, "achieved_rate_hz": 499.9,
-         "jitter_p50_ms": 0.02, "jitter_p99_ms": 0.2, "missed_cycles": 0, "bus_load_mean": 0.66,
+         "jitter_p50_ms": 0.02, "jitter_p99_ms": 0.2, "missed_cycles": 0, "missed_woke_late": 0,
+         "missed_overran": 0, "bus_load_mean": 0.66,
          "bus_bitrate_bit_s": 1_000_000, "cycles_held_for_a_command": 0, "cycles_without_every_answer": 3,
          "answer_latency": {"answered": 29997, "unanswered": 3, "p50_ms": 1.01, "p99_ms": 1.55,
                             "p99_9_ms": 1.83, "longest_ms": 7.1},
@@ -19,6 +20,7 @@ def test_the_full_stack_row_names_late_answers_and_the_answer_latency_and_fails_
     table = format_table({"full_stack": {"machine_floor": FLOOR, "500_hz_testbed_process": STACK}})
     row = next(line for line in table.splitlines() if line.startswith("| Full stack at 500 Hz"))
     assert "3 cycles without every drive's answer in time" in row
+    assert "0 missed (0 woke late, 0 after an overrun)" in row
     assert "answers 1.01 / 1.55 / 1.83 / 7.10 ms after the SYNC" in row
     assert "taken by the hypervisor during the run: CPU 0 0 ms, CPU 1 10 ms (to 10 ms)" in row
     assert row.rstrip().endswith("| NO |")          # 0 SYNCs missed, but 3 answers late
