@@ -6,8 +6,9 @@
 3. Which: fit every candidate effect (and a plain refit, the control) in parallel, rank them by
    held-out score (`candidates`); the best is chosen only if it removes more than noise can
    explain, both against the baseline and against its own ablation (the same fit with the
-   effect switched off), else the verdict is `none` with a description of the unexplained
-   residual. Where the best found effect reduces to a simpler one that is found too, and is not
+   effect switched off), and only if the baseline's error is significant against the tracker
+   noise at all; else the verdict is `none` with a description of the unexplained residual.
+   Where the best found effect reduces to a simpler one that is found too, and is not
    meaningfully better, the simpler one leads (`nested_candidates`). A second effect is added by
    greedy forward selection among the next best candidates found on their own, again only if the
    pair is meaningful against the control: the chosen effect refitted alone with the same budget.
@@ -41,7 +42,7 @@ from model.gap.plausibility import hold_drift_reasons, range_reasons, signature_
 from model.gap.recording import Recording, RecordingError
 from model.gap.regions import breakdown, concentrated, regions, shrink_by_region
 from model.gap.sample_features import SampleFeatures, compute_features
-from model.gap.significance import is_meaningful, is_significant_residual, model_form_rms_mm
+from model.gap.significance import is_meaningful, is_significant_residual, model_form_rms_mm, nothing_to_explain
 from model.gap.signatures import describe, signatures
 from model.gap.simulation import Resolution, predict_tips, predict_tips_and_tension
 from model.gap.starting_points import start_values
@@ -151,13 +152,17 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
         second effect to) and against its own ablation, the same fit with the effect switched off (the
         effect, not the refit of the base parameters that came with it, removes the error); and be
         plausible: its parameters inside their physical range, its gain where its signature says, and
-        no tip motion during static holds that the measured tip does not show."""
+        no tip motion during static holds that the measured tip does not show. And there must be
+        something to explain: the baseline's error on the selection half significant against the
+        tracker noise (`significance.is_significant_residual`), else the verdict is `none`."""
         if result.failed:
             return ["its held-out prediction failed (the model diverged or was given up): never a verdict"]
         before_all = before.holdout_errors if before else base_errors
         before_errors = split.selected(before_all)
         before_rmse = rmse_mm(before_errors)
         reasons = []
+        if not before and nothing_to_explain(before_rmse, noise):
+            reasons.append(f"{nothing_to_explain(before_rmse, noise)} on the selection half")
         if not is_meaningful(before_rmse, result.holdout_rmse_mm, noise):
             reasons.append(f"not significant: {before_rmse:.3f} -> {result.holdout_rmse_mm:.3f} mm on the selection "
                            "half removes no more than noise and fitting freedom explain")

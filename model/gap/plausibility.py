@@ -207,7 +207,7 @@ def worse_regions(features: SampleFeatures, before_mm: np.ndarray, after_mm: np.
     the zero-load region a little worse (the baseline's tendon zeros had taken up the offset there):
     on dahl seed 49 one did so by noise alone (C_R -0.04); on rod seed 69 one, above the visible
     limit, raised the after-reversal region from 0.339 to 0.467 mm, beyond noise, for a loss of
-    about 0.04 of its gain."""
+    about 0.04 of its gain (the region's share of samples estimated; module doc)."""
     squared_before = np.sum(np.asarray(before_mm) ** 2, axis=1)
     squared_after = np.sum(np.asarray(after_mm) ** 2, axis=1)
     gain_mm2 = float(np.sum(squared_before - squared_after))

@@ -44,6 +44,16 @@ def is_significant_residual(rmse_mm: float, noise_mm: float | None) -> bool:
     return rmse_mm ** 2 >= (1.0 + RESIDUAL_EXCESS) * 3.0 * noise_mm ** 2
 
 
+def nothing_to_explain(rmse_mm: float, noise_mm: float | None) -> str | None:
+    """Why no effect may be named on a baseline whose held-out error is `rmse_mm` (None: there is
+    something to explain): its error is within the tracker noise (`is_significant_residual` fails).
+    Without a noise estimate the data cannot tell, and nothing is ruled out here."""
+    if noise_mm is None or is_significant_residual(rmse_mm, noise_mm):
+        return None
+    return (f"nothing significant to explain: the baseline's {rmse_mm:.3f} mm is within the tracker noise "
+            f"(floor {np.sqrt(3.0) * noise_mm:.3f} mm)")
+
+
 def model_form_rms_mm(rmse_mm: float, noise_mm: float | None) -> float | None:
     """The part of a held-out error above the noise floor, sqrt(max(rmse^2 - f^2, 0)) (mm): what a
     model could remove at all; None without a noise estimate."""
