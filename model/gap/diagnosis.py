@@ -160,9 +160,8 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
         before_all = before.holdout_errors if before else base_errors
         before_errors = split.selected(before_all)
         before_rmse = rmse_mm(before_errors)
-        reasons = []
-        if not before and nothing_to_explain(before_rmse, noise):
-            reasons.append(f"{nothing_to_explain(before_rmse, noise)} on the selection half")
+        within_noise = None if before else nothing_to_explain(before_rmse, noise)
+        reasons = [f"{within_noise} on the selection half"] if within_noise else []
         if not is_meaningful(before_rmse, result.holdout_rmse_mm, noise):
             reasons.append(f"not significant: {before_rmse:.3f} -> {result.holdout_rmse_mm:.3f} mm on the selection "
                            "half removes no more than noise and fitting freedom explain")
