@@ -16,7 +16,10 @@ run itself: the cycles in which a drive's answer did not come within the master'
 which the goal counts as missed too; and how long the drives' answers took after each SYNC, as the master
 saw them (crest.driver.answer_latency: p50, p99, p99.9, longest), where the cycle's time goes.
 From the kernel: the time the hypervisor took from each CPU during the run (crest.bench.steal_time),
-when every thread on that CPU stood still.
+when every thread on that CPU stood still. With a profile folder, where each process of the run (the
+master, the served testbed, the command process) spent its time: each thread's CPU and, from
+py-spy's samples, where in the code each thread was (crest.bench.process_profile). The profiler stops each process for a moment at every sample and
+shares the two CPUs with the stack, so a profiled run's timing is not the goal's measurement.
 """
 from __future__ import annotations
 
@@ -24,11 +27,13 @@ import os
 import re
 import shutil
 import tempfile
+import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
 from control import Articulation, make_controller
+from crest.bench.process_profile import ProcessTreeProfile
 from crest.bench.steal_time import StealMeter
 from crest.config import default_config_path, load_testbed_config
 from crest.driver import SafetyStop
@@ -40,9 +45,13 @@ from crest.testbed_service.auto_start import MODE_VARIABLE
 from model import CatheterParams
 from sim_backend.bus_load import BusLoadMeter
 
+PROFILE_RATE_HZ = 100           # py-spy's samples per second of every thread
+PROFILE_DELAY_S = 4.0           # the profile starts once the run and its command process are going
+PROFILE_END_S = 8.0             # and ends this long before the run's nominal end
+
 
 def full_stack(sync_rate_hz: float = 500.0, duration_s: float = 60.0, controller_name: str = "dahl",
-               testbed_process: bool = True, realtime_priority: int = 0) -> dict:
+               testbed_process: bool = True, realtime_priority: int = 0, profile_folder: Path | None = None) -> dict:
     """The dahl circle at `sync_rate_hz`, with the virtual testbed in a process of its own (the master
     reaches its drives over the served bus, as it reaches drives on a real bus) or in this one.
 
@@ -50,11 +59,13 @@ def full_stack(sync_rate_hz: float = 500.0, duration_s: float = 60.0, controller
     with the SYNC period and realtime_priority changed, written to a temporary folder): a testbed
     process reads its configuration from a file. A run that a safety stop ends (a heartbeat lost
     when the processes cannot keep up) is measured up to the stop and reported with its cause.
+    profile_folder: where py-spy writes the raw stacks of each process of the run; the result then
+    has "profile" (ProcessTreeProfile.finish, each process with its "role").
     """
     with tempfile.TemporaryDirectory(prefix="crest-stack-") as folder:
         config = load_testbed_config(_config_at_rate(Path(folder), sync_rate_hz, realtime_priority))
         with _testbed_mode("process" if testbed_process else "in-process"):
-            result = _measure(config, sync_rate_hz, duration_s, controller_name)
+            result = _measure(config, sync_rate_hz, duration_s, controller_name, profile_folder)
     return {**result, "testbed": "its own process" if testbed_process else "this process"}
 
 
@@ -87,7 +98,8 @@ def _testbed_mode(mode: str) -> Iterator[None]:
             os.environ[MODE_VARIABLE] = before
 
 
-def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: str) -> dict:
+def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: str,
+             profile_folder: Path | None) -> dict:
     params = CatheterParams.from_toml()
     workspace, limits = workspace_for(config, params), limits_for(config)
     period_s = config.sync.period_s
@@ -109,6 +121,11 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
         session.testbed.sync_timing.reset()
         steal = StealMeter()
         steal.start()
+        profile = ProcessTreeProfile(os.getpid(), profile_folder, PROFILE_RATE_HZ) if profile_folder else None
+        profile_s = max(1.0, duration_s - PROFILE_DELAY_S - PROFILE_END_S)
+        starter = threading.Timer(PROFILE_DELAY_S, profile.start, args=(profile_s,)) if profile else None
+        if starter is not None:
+            starter.start()
         with session.backend.tapped(meter):
             try:
                 result = run_with_controller(session, trajectory, controller)
@@ -118,6 +135,11 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
                 stopped = str(stop)
             timing = session.testbed.sync_timing.summary()
         stolen = steal.stop()
+        profiled = None
+        if starter is not None:
+            starter.cancel()           # a run that stopped before its profile began has none
+            starter.join()
+            profiled = [{**row, "role": _role(row)} for row in profile.finish(timeout_s=duration_s)]
         load = meter.report()
         answers = session.testbed.answer_latency.summary()
         plant_rate_hz = session.backend.virtual.plant_rate_hz if session.backend.virtual is not None else None
@@ -138,4 +160,17 @@ def _measure(config, sync_rate_hz: float, duration_s: float, controller_name: st
             "testbed_scheduling": testbed_scheduling, "commands_in_own_process": command_process,
             "cycles_held_for_a_command": held_cycles, "cycles_without_every_answer": unanswered_cycles,
             "answer_latency": answers, "hypervisor": stolen,
-            "goal": "500 Hz with no missed cycle and p99 jitter <= 1 ms"}
+            "goal": "500 Hz with no missed cycle and p99 jitter <= 1 ms",
+            **({"profile": profiled, "profile_seconds": profile.duration_s, "profile_rate_hz": PROFILE_RATE_HZ}
+               if profiled is not None else {})}
+
+
+def _role(row: dict) -> str:
+    """Which process of the run a profiled process is, from its pid and command line."""
+    if row["pid"] == os.getpid():
+        return "master"
+    if "testbed serve" in row["command"]:
+        return "testbed"
+    if "command_worker" in row["command"]:
+        return "command process"
+    return "other"

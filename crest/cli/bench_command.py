@@ -11,6 +11,7 @@ from crest.bench import model_bench, plant_bench, stack_bench, view_bench
 from crest.cli.common_options import check_output
 from crest.bench.machine_info import machine_info
 from crest.bench.machine_stalls import PROBE_PERIOD_S, PROBE_PRIORITY, STALL_THRESHOLD_S, machine_floor
+from crest.bench.process_profile import ProfilerUnavailable
 from crest.gap.benchmark import GOAL_S, diagnosis_benchmarks
 from model import CatheterParams
 
@@ -18,7 +19,8 @@ GAP_CASES = {"synthetic": "Gap diagnosis, synthetic 10-min 100 Hz log (easy case
              "virtual_testbed": "Gap diagnosis, 10-min 100 Hz virtual-testbed log, drawn plant",
              "real": "Gap diagnosis, longest real log"}
 STACK_REALTIME_PRIORITY = 20    # SCHED_FIFO priority of the full stack's threads (crest.driver.realtime_scheduling)
-SECTIONS = ("model", "dynamic", "scaling", "move", "controllers", "rod_plant", "full_stack", "gap", "view")
+SECTIONS = ("model", "dynamic", "scaling", "move", "controllers", "rod_plant", "full_stack", "stack_profile", "gap",
+            "view")
 
 
 def add_parser(sub) -> None:
@@ -71,6 +73,8 @@ def run(args: argparse.Namespace) -> int:
                                                                               testbed_process=True),
             "500_hz_one_process": stack_bench.full_stack(500.0, args.stack_seconds, testbed_process=False,
                                                          realtime_priority=args.realtime_priority)},
+        "stack_profile": lambda: stack_profile_result(args.stack_seconds, args.realtime_priority,
+                                                      path.parent / f"{path.stem}_profile"),
         "gap": lambda: diagnosis_benchmarks(args.gap_seed, args.real_data, cases=args.gap_cases,
                                             progress=lambda message: print(f"crest bench: {message}",
                                                                            file=sys.stderr, flush=True)),
@@ -101,12 +105,49 @@ def machine_floor_result(duration_s: float, stack_priority: int) -> dict:
             "stalls_over_1_ms_on_every_cpu": floor.on_every_cpu(0.001)}
 
 
+def stack_profile_result(duration_s: float, priority: int, folder: Path) -> dict:
+    """The 500 Hz full stack across processes once more, each process profiled (stack_bench,
+    crest.bench.process_profile), py-spy's raw stacks in `folder`. Where py-spy cannot read the
+    processes, the reason instead."""
+    try:
+        return stack_bench.full_stack(500.0, duration_s, testbed_process=True, realtime_priority=priority,
+                                      profile_folder=folder)
+    except ProfilerUnavailable as error:
+        return {"unavailable": str(error)}
+
+
 def _steal_text(hypervisor: dict) -> str:
     """The hypervisor's steal time during one stack run (crest.bench.steal_time), or nothing."""
     if not hypervisor["steal_ms_per_cpu"]:
         return ""
     per_cpu = ", ".join(f"CPU {cpu} {ms:g} ms" for cpu, ms in hypervisor["steal_ms_per_cpu"].items())
     return f"; taken by the hypervisor during the run: {per_cpu} (to {hypervisor['resolution_ms']:g} ms)"
+
+
+def _profile_rows(r: dict | None) -> list[tuple]:
+    """The profiled run's rows: its timing, then each process's CPU by thread, with where each thread is."""
+    if r is None:
+        return []
+    label = "Full stack at 500 Hz across processes, profiled"
+    if "unavailable" in r:
+        return [(label, f"no profile: {r['unavailable']}", "-", None)]
+    rows = [(f"{label} ({r['duration_s']:.0f} s; py-spy at {r['profile_rate_hz']} samples/s of every thread for "
+             f"{r['profile_seconds']:.0f} s, stopping each process to read it)",
+             f"{r['achieved_rate_hz']:.0f} Hz, jitter p99 {r['jitter_p99_ms']:.2f} ms, {r['missed_cycles']} missed"
+             + _steal_text(r["hypervisor"]), "not the goal's measurement", None)]
+    for process in r["profile"]:
+        threads = []
+        for thread in process["threads"]:
+            cpu = thread["cpu_user"] + thread["cpu_kernel"]
+            if cpu >= 0.01:
+                where = ", ".join(f"{name} {100 * share:.0f}%" for name, share in thread["components"].items()
+                                  if share >= 0.1)
+                threads.append(f"{thread['name']} {100 * cpu:.0f}% ({where or 'not sampled'})")
+        rows.append((f"Profile: {process['role']} (pid {process['pid']})",
+                     f"CPU {100 * (process['cpu_user'] + process['cpu_kernel']):.0f}% of one CPU "
+                     f"({100 * process['cpu_kernel']:.0f}% in the kernel); by thread, with where it was: "
+                     + ("; ".join(threads) or "none used 1%"), "-", None))
+    return rows
 
 
 def format_table(results: dict) -> str:
@@ -169,6 +210,7 @@ def format_table(results: dict) -> str:
                      "rate held, 0 missed (SYNC late or an answer late), p99 <= 1 ms",
                      not r["stopped"] and r["missed_cycles"] == 0 and r["cycles_without_every_answer"] == 0
                      and r["jitter_p99_ms"] <= 1.0))
+    rows += _profile_rows(results.get("stack_profile"))
     notes = []
     for key, r in results.get("gap", {}).items():
         label = GAP_CASES[key]

@@ -26,3 +26,23 @@ def test_the_full_stack_row_names_late_answers_and_the_answer_latency_and_fails_
     assert row.rstrip().endswith("| NO |")          # 0 SYNCs missed, but 3 answers late
     floor = next(line for line in table.splitlines() if line.startswith("| Machine floor"))
     assert "1 stalls over 1 ms on any CPU" in floor and "CPU 0: 1, CPU 1: 1; 1 on every CPU at once" in floor
+
+
+def test_the_profiled_run_shows_each_process_cpu_by_thread_and_where_each_thread_was_or_why_there_is_none():
+    cycle = {"tid": 11, "name": "MainThread", "cpu_user": 0.3, "cpu_kernel": 0.1, "samples": 4800,
+             "components": {"cycle, PDOs and supervision (crest/driver/)": 0.7, "canopen": 0.25, "python-can": 0.05}}
+    idle = {"tid": 13, "name": "aurora /dev/pts/0", "cpu_user": 0.004, "cpu_kernel": 0.0, "samples": 4800,
+            "components": {"tracker client (crest/tracker/)": 1.0}}
+    profile = [{"pid": 11, "command": "crest bench", "role": "master", "cpu_user": 0.304, "cpu_kernel": 0.1,
+                "threads": [cycle, idle]}]
+    profiled = {**STACK, "profile": profile, "profile_seconds": 48.0, "profile_rate_hz": 100}
+    lines = format_table({"stack_profile": profiled}).splitlines()
+    run = next(line for line in lines if line.startswith("| Full stack at 500 Hz across processes, profiled"))
+    assert "py-spy at 100 samples/s of every thread for 48 s" in run and "0 missed" in run
+    assert run.rstrip().endswith("| not the goal's measurement | - |")
+    master = next(line for line in lines if line.startswith("| Profile: master (pid 11)"))
+    assert ("CPU 40% of one CPU (10% in the kernel); by thread, with where it was: MainThread 40% "
+            "(cycle, PDOs and supervision (crest/driver/) 70%, canopen 25%)") in master
+    assert "python-can" not in master and "aurora" not in master      # under 10% of samples, under 1% CPU
+    refused = format_table({"stack_profile": {"unavailable": "py-spy is not installed"}})
+    assert "| Full stack at 500 Hz across processes, profiled | no profile: py-spy is not installed |" in refused

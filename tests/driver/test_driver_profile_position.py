@@ -119,3 +119,17 @@ def test_jogging_replaces_the_target_on_the_way(homed):
     cap_mm_s = 0.25 * tendon1.max_velocity_mm_s                                      # the jog speed cap
     assert homed.object_value("tendon1", 0x6081) == round(cap_mm_s * tendon1.counts_per_mm)
     assert max(speeds) <= cap_mm_s * 1.05   # the servo catching up its lag after the reversal
+
+
+def test_a_move_on_a_host_that_sends_its_syncs_late_gets_the_drives_time_not_a_false_timeout(homed):
+    """Every SYNC leaves 1.5 periods late (a busy host): the drives, which move one cycle per SYNC, take
+    2.5 times as long in the master's time, past the planned time plus its margin; the move still ends
+    at its targets rather than in a timeout."""
+    period_s = homed.config.sync.period_s
+    on_time = homed.clock.wait_until
+    homed.clock.wait_until = lambda deadline_s: on_time(deadline_s + 1.5 * period_s)
+    start_s = homed.clock.now_s()
+    targets = homed.testbed.targets_from_pulls(0.0, 0.0, 60.0)        # insertion 40 mm at 10 mm/s
+    homed.testbed.move_to(targets)
+    assert homed.clock.now_s() - start_s > 2 * (40.0 / 10.0) + 1.0      # well past the planned time + margin
+    assert homed.testbed.positions().values() == pytest.approx(targets.values(), abs=0.021)
