@@ -48,7 +48,7 @@ COMPONENTS = (   # (name, path fragment); the first fragment found in a frame's 
 )
 RUNTIME = "Python runtime and standard library"
 _FRAME_FILE = re.compile(r"\((.*):\d+\)$")
-_THREAD_FRAME = re.compile(r"^thread \((\d+)\): ([^;]*);?")
+_THREAD_FRAME = re.compile(r"^thread \((\d+)\)(?:: ([^;]*))?;?")   # no name where the threading module is not loaded
 _TICK_S = 1.0 / os.sysconf("SC_CLK_TCK")
 
 
@@ -174,7 +174,8 @@ def component_of(frames: list[str]) -> str:
 
 def thread_components(raw_path: Path) -> tuple[dict[int, str], dict[int, Counter]]:
     """({tid: thread name}, {tid: samples per component}) from py-spy's raw output with --threads:
-    one "thread (TID): NAME;frame;frame;... count" line per distinct stack, root first."""
+    one "thread (TID): NAME;frame;frame;... count" line per distinct stack, root first (without
+    ": NAME" for a thread that Python's threading module has not named)."""
     names: dict[int, str] = {}
     counts: dict[int, Counter] = {}
     for line in raw_path.read_text().splitlines():
@@ -183,6 +184,6 @@ def thread_components(raw_path: Path) -> tuple[dict[int, str], dict[int, Counter
         if thread is None or not count.isdigit():
             continue
         tid = int(thread.group(1))
-        names[tid] = thread.group(2)
+        names[tid] = thread.group(2) or "(no name)"
         counts.setdefault(tid, Counter())[component_of(stack[thread.end():].split(";"))] += int(count)
     return names, counts

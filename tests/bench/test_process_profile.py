@@ -7,7 +7,8 @@ import textwrap
 
 import pytest
 
-from crest.bench.process_profile import RUNTIME, ProcessTreeProfile, ProfilerUnavailable, component_of
+from crest.bench.process_profile import (RUNTIME, ProcessTreeProfile, ProfilerUnavailable, component_of,
+                                         thread_components)
 
 SPIN = "def spin():\n    while True:\n        sum(range(1000))\n"
 
@@ -19,6 +20,15 @@ def test_a_stack_belongs_to_the_innermost_component_it_passes_through():
     assert component_of(["<module> (/x/crest/cli/main.py:1)", "run (/x/model/quasi_static_kernel.py:3)"]) \
         == "model (model/)"
     assert component_of(["_bootstrap (/usr/lib/python3.11/threading.py:1)"]) == RUNTIME
+
+
+def test_a_thread_that_the_threading_module_never_named_is_still_counted(tmp_path):
+    raw = tmp_path / "raw.txt"
+    raw.write_text("thread (41);<module> (/x/model/spin.py:4);spin (/x/model/spin.py:3) 99\n"
+                   "thread (42): Thread-1 (work);run (/x/control/dahl.py:7) 3\n")
+    names, counts = thread_components(raw)
+    assert names == {41: "(no name)", 42: "Thread-1 (work)"}
+    assert counts[41] == {"model (model/)": 99} and counts[42] == {"controller (control/)": 3}
 
 
 def test_a_process_and_its_child_each_get_their_cpu_and_the_component_they_spend_it_in(tmp_path):
@@ -48,7 +58,7 @@ def test_a_process_and_its_child_each_get_their_cpu_and_the_component_they_spend
     assert str(child_script) in rows[child_pid]["command"]
     for pid, component in ((process.pid, "model (model/)"), (child_pid, "plant (sim_backend/plant/)")):
         spinner = rows[pid]["threads"][0]                     # the thread with the most CPU
-        assert spinner["name"] == "MainThread" and spinner["samples"] > 0
+        assert spinner["name"] in ("MainThread", "(no name)") and spinner["samples"] > 0
         assert max(spinner["components"], key=spinner["components"].get) == component
         assert abs(sum(spinner["components"].values()) - 1.0) < 1e-9
         cpu = spinner["cpu_user"] + spinner["cpu_kernel"]
