@@ -1,11 +1,12 @@
 """Where each process of a run spends its time: each thread's CPU, and what each thread runs.
 
 For the process `root_pid` and every process it has started by then (the served testbed, the
-command process), over the same span D:
+command process), for the same span D of py-spy's sampling:
 - **CPU**: the kernel's count of each thread's time on a CPU, in user mode and in the kernel
   (utime and stime of /proc/PID/task/TID/stat), as a share of one CPU's time:
-  (utime_end - utime_start) / D, the same for stime; a thread that started during the span
-  counts from zero;
+  (utime_end - utime_start) / W, the same for stime, W the wall time (time.monotonic) between the
+  two reads: py-spy takes a moment to attach and to end, so W is a little longer than D; a thread
+  that started during the span counts from zero;
 - **what the thread runs**: py-spy (a sampling profiler that reads a Python process's stacks
   from outside it) samples every thread `rate_hz` times a second, waiting or not (``--idle
   --threads``: the thread states py-spy would use to leave out waiting threads count every
@@ -25,6 +26,7 @@ import re
 import shutil
 import subprocess
 import threading
+import time
 from collections import Counter
 from pathlib import Path
 
@@ -67,22 +69,25 @@ class ProcessTreeProfile:
         self.folder = Path(folder)
         self.rate_hz = int(rate_hz)
         self.duration_s = 0.0
+        self.unavailable = ""        # why `start` profiled nothing; `finish` raises it
         self._runs: list[dict] = []
 
     def start(self, duration_s: float) -> None:
         """Profile the root and its children for `duration_s` (whole seconds), each thread's CPU
-        read as its process's profiler starts and as it ends."""
+        read as its process's profiler starts and as it ends. It may run in a timer thread, where an
+        exception would reach no one, so what stops it is kept in `unavailable` for `finish`."""
         self.duration_s = float(max(1, int(round(duration_s))))
         self.folder.mkdir(parents=True, exist_ok=True)
         if not Path(f"/proc/{self.root_pid}").exists():
-            raise ProfilerUnavailable(f"no process {self.root_pid} to profile")
+            self.unavailable = f"no process {self.root_pid} to profile"
+            return
         for pid in (self.root_pid, *children_of(self.root_pid)):
             try:
                 command = command_of(pid)
             except OSError:     # a child that ended meanwhile
                 continue
             run = {"pid": pid, "command": command, "out": self.folder / f"profile_{pid}.txt",
-                   "cpu_before": thread_cpu_seconds(pid)}
+                   "cpu_before": thread_cpu_seconds(pid), "read_before_s": time.monotonic()}
             run["profiler"] = subprocess.Popen(
                 [self._executable, "record", "--idle", "--threads", "--full-filenames", "--format", "raw",
                  "--rate", str(self.rate_hz), "--duration", str(int(self.duration_s)), "--output", str(run["out"]),
@@ -97,12 +102,15 @@ class ProcessTreeProfile:
         """Wait for one profiler to end, then read its process's CPU at once (before it may exit)."""
         _, run["errors"] = run["profiler"].communicate()
         run["cpu_after"] = thread_cpu_seconds(run["pid"])
+        run["read_after_s"] = time.monotonic()
 
     def finish(self, timeout_s: float) -> list[dict]:
         """Per process profiled (root first): {"pid", "command", "raw", "cpu_user", "cpu_kernel",
         "threads": [{"tid", "name", "cpu_user", "cpu_kernel", "samples", "components": {name:
         share}}, most CPU first]}; ProfilerUnavailable, in py-spy's words, where py-spy wrote no
-        profile of a process."""
+        profile of a process or where `start` could not begin."""
+        if self.unavailable:
+            raise ProfilerUnavailable(self.unavailable)
         rows = []
         for run in self._runs:
             run["watcher"].join(timeout_s)
@@ -114,13 +122,13 @@ class ProcessTreeProfile:
                 raise ProfilerUnavailable(f"py-spy wrote no profile of pid {run['pid']} "
                                           f"(exit {run['profiler'].returncode}): {last[-1] if last else 'no message'}")
             names, counts = thread_components(run["out"])
-            threads = []
+            threads, window_s = [], run["read_after_s"] - run["read_before_s"]
             for tid, (user_after, kernel_after) in run["cpu_after"].items():
                 user_before, kernel_before = run["cpu_before"].get(tid, (0.0, 0.0))
                 samples = sum(counts.get(tid, Counter()).values())
                 threads.append({"tid": tid, "name": names.get(tid, "(not sampled)"),
-                                "cpu_user": (user_after - user_before) / self.duration_s,
-                                "cpu_kernel": (kernel_after - kernel_before) / self.duration_s,
+                                "cpu_user": (user_after - user_before) / window_s,
+                                "cpu_kernel": (kernel_after - kernel_before) / window_s,
                                 "samples": samples,
                                 "components": {name: n / samples for name, n in counts[tid].most_common()}
                                 if samples else {}})

@@ -18,8 +18,9 @@ saw them (crest.driver.answer_latency: p50, p99, p99.9, longest), where the cycl
 From the kernel: the time the hypervisor took from each CPU during the run (crest.bench.steal_time),
 when every thread on that CPU stood still. With a profile folder, where each process of the run (the
 master, the served testbed, the command process) spent its time: each thread's CPU and, from
-py-spy's samples, where in the code each thread was (crest.bench.process_profile). The profiler stops each process for a moment at every sample and
-shares the two CPUs with the stack, so a profiled run's timing is not the goal's measurement.
+py-spy's samples, where in the code each thread was (crest.bench.process_profile). The profiler
+stops each process for a moment at every sample and shares the two CPUs with the stack, so a
+profiled run's timing is not the goal's measurement.
 """
 from __future__ import annotations
 
