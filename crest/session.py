@@ -1,7 +1,8 @@
 """One operator session: the testbed a configuration names, booted, with its tip tracker.
 
 `open_session` is what every CLI command and experiment uses. Leaving it by any route (normal
-end, Ctrl-C, an exception, a safety stop) leaves every axis stopped and the bus closed.
+end, Ctrl-C, an exception, a safety stop) leaves every axis stopped and the bus closed. In it a
+Ctrl-C or SIGTERM is taken at the start of the next SYNC cycle (crest.driver.stop_requests).
 """
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from pathlib import Path
 
 from crest.backend import Backend, open_backend
 from crest.config import TestbedConfig, load_testbed_config
-from crest.driver import MonotonicClock, SteppedClock, Testbed
+from crest.driver import MonotonicClock, SteppedClock, Testbed, stop_requests
 from crest.driver.realtime_scheduling import Scheduling, realtime_threads
 from crest.experiment.tip_feed import TipFeed
 from crest.testbed_service.cpu_split import beside
@@ -77,6 +78,7 @@ def open_session(options: SessionOptions = SessionOptions()) -> Iterator[Session
                            tracker_noise_mm=options.tracker_noise_mm,
                            tracker_dropout=options.tracker_dropout)
     with ExitStack() as stack:
+        stack.enter_context(stop_requests.at_safe_points())     # left last: after every part is closed
         stack.callback(backend.close)
         if backend.served is not None:
             stack.enter_context(beside(backend.served.cpus))

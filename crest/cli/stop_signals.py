@@ -5,7 +5,10 @@ KeyboardInterrupt. An interrupt (Ctrl-C, or `kill -INT` from a supervisor) must 
 axis and save the log, however crest was started, so SIGINT always raises KeyboardInterrupt.
 SIGTERM (`kill PID`, a service manager) takes the same path with its own exception, Terminated;
 later SIGTERMs are ignored, so a supervisor that repeats the signal cannot break off the stop the
-first one started (SIGKILL still ends the process).
+first one started (SIGKILL still ends the process). While a session holds the testbed the
+exception is not raised where the signal finds the main thread but at the cycle's next safe point
+(crest.driver.stop_requests): raised inside a library's locking code it can leave a lock held and
+hang the stop itself.
 
 Processes the command forks (the fits' process pool) inherit these handlers. Ctrl-C in a terminal
 and a service manager's stop signal the whole process group, and an exception in such a worker
@@ -17,7 +20,7 @@ from __future__ import annotations
 import os
 import signal
 
-from crest.driver import Terminated
+from crest.driver import Terminated, stop_requests
 
 
 def install_stop_signals() -> None:
@@ -27,13 +30,17 @@ def install_stop_signals() -> None:
     def interrupt(signum, frame) -> None:
         if os.getpid() != command_pid:
             _end_quietly(signum)
-        raise KeyboardInterrupt
+        error = KeyboardInterrupt()
+        if not stop_requests.request(error):
+            raise error
 
     def terminate(signum, frame) -> None:
         if os.getpid() != command_pid:
             _end_quietly(signum)
         signal.signal(signal.SIGTERM, signal.SIG_IGN)
-        raise Terminated()
+        error = Terminated()
+        if not stop_requests.request(error):
+            raise error
 
     signal.signal(signal.SIGINT, interrupt)
     signal.signal(signal.SIGTERM, terminate)

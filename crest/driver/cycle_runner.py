@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import can
 
 from crest.config import TestbedConfig
-from crest.driver import cia402
+from crest.driver import cia402, stop_requests
 from crest.driver.cia402 import Cia402State, OperationMode
 from crest.driver.clock import Clock
 from crest.driver.drive_axis import DriveAxis
@@ -91,8 +91,10 @@ class CycleRunner:
     # --- cycles ------------------------------------------------------------------------------
     def cycle(self, limited: Sequence[str] = (), meanwhile: Callable[[], None] | None = None) -> CycleSample:
         """One supervised SYNC cycle (``meanwhile``: see SyncCycle.run); SafetyStop if the testbed
-        is (or gets) stopped."""
+        is (or gets) stopped. Its start is the safe point where a Ctrl-C or SIGTERM is raised
+        (stop_requests), and from there the driver call stops every axis."""
         self.raise_if_stopped()
+        stop_requests.raise_requested()
         latched = [axis.sent_target_counts if axis.mode is OperationMode.CYCLIC_SYNC_POSITION else None
                    for axis in self.axes]
         now_s, fresh = self.sync.run(meanwhile)

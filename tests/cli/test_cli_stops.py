@@ -13,6 +13,7 @@ import time
 
 from cli_runner import REPO, assert_every_drive_quick_stopped, crest, start_crest
 from crest.config import default_config_path
+from crest.driver.cia402 import QUICK_STOP
 from crest.exit_codes import ExitCode
 from crest.log import read_log
 
@@ -165,3 +166,49 @@ def test_sigterm_to_a_command_and_its_fit_pool_ends_both_at_once_without_a_trace
     assert process.returncode == 4, stderr
     assert stderr == "stopped by SIGTERM\n"                          # no traceback from a worker
     assert time.monotonic() - started < 100                           # far from the fits' 600 s
+
+
+MID_CYCLE_INTERRUPT_SCRIPT = """
+import json, signal, struct
+from crest.cli.stop_signals import install_stop_signals
+from crest.driver import SafetyStop
+from crest.session import SessionOptions, open_session
+
+install_stop_signals()
+sent = []                     # (COB-ID, controlword or None) of every frame the host sent, in order
+interrupted_at = []
+def on_frame(frame):
+    if frame.is_rx:
+        return
+    rpdo = 0x201 <= frame.arbitration_id <= 0x205
+    sent.append((frame.arbitration_id, struct.unpack("<H", bytes(frame.data[:2]))[0] if rpdo else None))
+    if frame.arbitration_id == 0x201 and not interrupted_at and [c for c, _ in sent].count(0x80) == 50:
+        interrupted_at.append(len(sent))
+        signal.raise_signal(signal.SIGINT)     # Ctrl-C with four RPDOs and the SYNC of this cycle to go
+try:
+    with open_session(SessionOptions(realtime=False, in_process=True, tracker=False)) as session:
+        session.backend.bus.tap(on_frame)
+        session.testbed.hold(60.0)
+    cause = None
+except SafetyStop as stop:
+    cause = {"exit_code": int(stop.exit_code), "text": str(stop)}
+print(json.dumps({"cause": cause, "after": sent[interrupted_at[0]:interrupted_at[0] + 11]}))
+"""
+
+
+def test_a_ctrl_c_while_a_cycle_is_sent_is_taken_after_its_sync_and_stops_every_axis():
+    """crest.driver.stop_requests: in a session the CLI's SIGINT handler does not raise where the
+    signal finds the main thread (inside python-can's send, it can leave a receiver's queue locked and
+    hang the stop). Here the Ctrl-C comes while the host sends a cycle, right after its first RPDO: the
+    cycle's other four RPDOs and its SYNC still go out, then every drive gets the quick stop, and the
+    session ends in the stop for Ctrl-C."""
+    process = subprocess.run([sys.executable, "-c", MID_CYCLE_INTERRUPT_SCRIPT], capture_output=True, text=True,
+                             timeout=300, cwd=REPO)
+    assert process.returncode == 0, process.stderr
+    result = json.loads(process.stdout)
+    assert result["cause"]["exit_code"] == ExitCode.INTERRUPTED and "Ctrl-C" in result["cause"]["text"]
+    cob_ids = [cob_id for cob_id, _ in result["after"]]
+    assert cob_ids[:5] == [0x202, 0x203, 0x204, 0x205, 0x80]       # the cycle the signal came in, whole
+    stops = [(cob_id, word) for cob_id, word in result["after"][5:] if word == QUICK_STOP]
+    assert sorted(cob_id for cob_id, _ in stops[:5]) == [0x201, 0x202, 0x203, 0x204, 0x205]
+    assert 0x80 not in cob_ids[5:cob_ids.index(stops[4][0], 5) + 1]   # before any further SYNC
