@@ -13,10 +13,13 @@ So inside ``at_safe_points`` (the whole of ``crest.session.open_session``) the C
 *request* the stop: ``request`` keeps the exception, and ``raise_requested`` raises it where the
 main thread holds no lock, at the start of every supervised cycle (``CycleRunner.cycle``). From
 there it takes the path it always took: the driver call turns it into the stop of every axis. It
-comes at most one SYNC cycle late while the testbed cycles; while it does not (the boot's SDO
-exchanges, a wait for a tracker frame) at most one reply timeout late, and nothing moves then. A
-stop requested once the last cycle is over is raised when the block ends, after every part of the
-session is closed, unless an exception already ends the block (that stop is under way).
+comes at most one SYNC cycle late while the testbed cycles. Where the main thread waits between
+cycles it comes once the wait is over: an SDO exchange (the boot's, a mode change's: at most its
+SDO timeout), and in simulated time the wait for a tracker frame (at most STALLED_TRACKER_TIMEOUT_S
+and, once per loss of the link, RECONNECT_GRACE_S of wall time, crest.experiment.tip_feed: 7 s, in
+which simulated time and so the drives stand still). A stop requested once the last cycle is over
+is raised when the block ends, after every part of the session is closed, unless an exception
+already ends the block (that stop is under way).
 
 Outside the block, or without the CLI's handlers (a script using the driver), a signal raises
 at once, as it does by default.
