@@ -3,6 +3,7 @@
     crest gap TRAIN.csv [...] --holdout TEST.csv [...] --json OUT.json --report DIR
     crest gap --blind-benchmark --cases 40 --seed S --json OUT.json --report DIR
     crest gap --real-data [DIR] --json OUT.json: every real log held out once (crest.gap.real_data_table)
+    crest gap --combine BLIND.json [...]: stored blind results scored together (crest.gap.blind_combine)
     either with --scheduler tcp://HOST:PORT: the fits run on a Dask cluster (crest.gap.fit_executor)
 """
 from __future__ import annotations
@@ -15,6 +16,7 @@ from pathlib import Path
 
 from crest.cli.common_options import check_output
 from crest.gap.blind_benchmark import run_blind_benchmark
+from crest.gap.blind_combine import combined_scores
 from crest.gap.fit_executor import check_scheduler_address, dask_executor, open_executor
 from crest.gap.log_diagnosis import diagnose_logs
 from crest.gap.log_recordings import load_recordings
@@ -42,6 +44,9 @@ def add_parser(sub) -> None:
                         help="tabulate calibrated constant curvature, calibrated Dahl and Dahl + verdict as held-out "
                              "RMSE for every real log in DIR (default ../shared/data/continuum_nathan), each held "
                              "out once in a two-fold cross-validation over the files")
+    parser.add_argument("--combine", nargs="+", type=Path, default=None, metavar="BLIND.json",
+                        help="score stored blind-benchmark results (--blind-benchmark --json) together: every case "
+                             "of these files, per family")
     parser.add_argument("--cases", type=int, default=40, help="blind benchmark: number of cases (default 40)")
     parser.add_argument("--seed", type=int, default=0, help="blind benchmark: random seed")
     parser.add_argument("--family", choices=("dahl", "rod", "both"), default="dahl",
@@ -63,6 +68,13 @@ def run(args: argparse.Namespace) -> int:
     if args.scheduler is not None:
         check_scheduler_address(args.scheduler)
     settings = DiagnosisSettings(workers=args.workers)
+    if args.combine is not None:
+        if args.train or args.holdout or args.blind_benchmark or args.real_data is not None:
+            raise ValueError("--combine scores stored results; do not pass logs, --blind-benchmark or --real-data")
+        scores = combined_scores(args.combine)
+        _write_json({"combined": [str(path) for path in args.combine], "score": scores}, args.json_path)
+        print("\n".join(format_family_score(family, score) for family, score in scores.items()))
+        return 0
     if args.real_data is not None:
         if args.train or args.holdout or args.blind_benchmark:
             raise ValueError("--real-data makes its own folds of the real logs; do not pass logs or --blind-benchmark")
@@ -160,22 +172,26 @@ def format_score(score: dict) -> str:
 
 
 def format_family_score(family: str, score: dict) -> str:
-    """The family's heading, `format_score`, and the scores the issue-14 benchmark adds."""
-    def pct(value: float | None) -> str:
-        return "-" if value is None else f"{100 * value:.0f} %"
-
+    """The family's heading, `format_score`, and the scores the issue-14 benchmark adds (counted)."""
     counts = score["counts"]
     lines = [f"== {family} family ==", format_score(score),
-             f"top-1 above the detection limit ({counts['single_above_detection']} cases): "
-             f"{pct(score['top1_single_above_detection'])} (target >= 90 %)",
+             f"top-1 above the detection limit: {_count(score['top1_single_above_detection'], counts['single_above_detection'])}"
+             " (target >= 90 %)",
              f"clean cases with no catalog effect named ('none' or 'unexplained'): "
-             f"{pct(score['no_catalog_effect_clean'])} (target >= 80 %)"]
+             f"{_count(score['no_catalog_effect_clean'], counts['none'])} (target >= 80 %)"]
     if counts.get("single_with_visible_size"):
         lines.append(f"top-1 above the detection limit by the effect's visible part, what the calibrated model "
-                     f"cannot absorb ({counts['single_above_visible_limit']} cases): "
-                     f"{pct(score['top1_single_above_visible_limit'])}")
+                     f"cannot absorb: {_count(score['top1_single_above_visible_limit'], counts['single_above_visible_limit'])}")
+    if counts.get("single_above_detection_with_candidates"):
+        lines.append("the true effect ranked first among the candidates above the detection limit, the most any "
+                     f"verdict rule could name: {_count(score['truth_ranked_first_above_detection'], counts['single_above_detection_with_candidates'])}")
     if counts["out_of_catalog"]:
-        lines.append(f"out-of-catalog cases 'unexplained': {pct(score['unexplained_out_of_catalog'])} "
-                     f"(target >= 80 %); a catalog effect named in {score['catalog_effect_out_of_catalog']} of "
-                     f"{counts['out_of_catalog']}")
+        lines.append(f"out-of-catalog cases 'unexplained': "
+                     f"{_count(score['unexplained_out_of_catalog'], counts['out_of_catalog'])} (target >= 80 %); "
+                     f"a catalog effect named in {score['catalog_effect_out_of_catalog']}")
     return "\n".join(lines)
+
+
+def _count(fraction: float | None, cases: int) -> str:
+    """'k of n (p %)' for a fraction of n cases; '-' without cases."""
+    return "-" if fraction is None else f"{round(fraction * cases)} of {cases} ({100 * fraction:.0f} %)"

@@ -21,7 +21,9 @@ tracker noise floor and by at least DETECTION_RATIO of the baseline residual); t
 curve, top-1 per effect against the effect's size relative to the baseline residual
 (effect RMS / held-out baseline RMSE); on clean cases the share with no catalog effect named
 (`none` and `unexplained` both right); on out-of-catalog cases the share `unexplained` and the
-number with a catalog effect named; pair accuracy (dahl); and the error of the published shrink
+number with a catalog effect named; how often the true effect is the best-ranked candidate above
+the detection limit (the verdict names a candidate or nothing, so this bounds the top-1 that any
+verdict rule could reach on these fits); pair accuracy (dahl); and the error of the published shrink
 against an oracle shrink on the same report half of the held-out log
 (`model.gap.holdout_split`), over the cases with an effect (clean cases are left out: their
 predicted and oracle shrink are both about 0, which would flatter the mean).
@@ -462,6 +464,7 @@ def score(all_rows: list[dict]) -> dict:
     audible = [r for r in singles if r.get("above_noise", True)]     # a case without a result counts
     detectable = [r for r in singles if r.get("above_detection_limit", True)]
     visible = [r for r in singles if r.get("above_visible_limit", False)]
+    ranked = [r for r in detectable if r.get("candidates")]     # results before 2026-11-24 kept no candidates
     clean = [r for r in rows if r["kind"] == "none"]
     outside = [r for r in rows if r["kind"] == "out_of_catalog"]
     pairs = [r for r in rows if r["kind"] == "pair"]
@@ -477,6 +480,8 @@ def score(all_rows: list[dict]) -> dict:
         "top1_single_above_detection": fraction([r["predicted"] == r["truth"][0] for r in detectable]),
         "detection_curve": detection_curve(singles),
         "top1_single_above_visible_limit": fraction([r["predicted"] == r["truth"][0] for r in visible]),
+        "truth_ranked_first_above_detection": fraction([r["candidates"][0]["effect"] == r["truth"][0]
+                                                        for r in ranked]),
         "visible_detection_curve": detection_curve(singles, "visible_relative_size"),
         "none_clean": fraction([r["predicted"] == "none" for r in clean]),
         "no_catalog_effect_clean": fraction([r["predicted"] in ("none", UNEXPLAINED) for r in clean]),
@@ -491,6 +496,7 @@ def score(all_rows: list[dict]) -> dict:
         "confusion": confusion,
         "counts": {"single": len(singles), "single_below_noise": len(singles) - len(audible),
                    "single_above_detection": len(detectable), "single_above_visible_limit": len(visible),
+                   "single_above_detection_with_candidates": len(ranked),
                    "single_with_visible_size": sum("visible_relative_size" in r for r in singles),
                    "none": len(clean), "pair": len(pairs),
                    "out_of_catalog": len(outside),

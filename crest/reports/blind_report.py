@@ -92,6 +92,10 @@ def _family_markdown(family: str, score: dict) -> list[str]:
         *([f"| top-1 above the detection limit by the effect's visible part (what the calibrated model cannot absorb) | "
            f"{_pct(score['top1_single_above_visible_limit'])} of {counts['single_above_visible_limit']} | - |"]
           if counts.get("single_with_visible_size") else []),
+        *([f"| the true effect ranked first among the candidates, above the detection limit (the most any verdict "
+           f"rule could name) | {_pct(score['truth_ranked_first_above_detection'])} of "
+           f"{counts['single_above_detection_with_candidates']} | - |"]
+          if counts.get("single_above_detection_with_candidates") else []),
         f"| top-1 where the effect moves the tip more than the tracker noise | "
         f"{_pct(score['top1_single_above_noise'])} of {counts['single'] - counts['single_below_noise']} | - |",
         f"| clean cases with no catalog effect (`none` or `unexplained`) | {_pct(score['no_catalog_effect_clean'])} "

@@ -98,3 +98,17 @@ def test_a_drawn_rod_plant_its_description_refuses_is_named_and_redrawn(tmp_path
     refusal = plant_description_refusal(write_plant_config(case, tmp_path / "drawn"))
     assert refusal is not None and "lumen_offset_drift" in refusal and "outside" in refusal
     assert plant_description_refusal(write_plant_config(_redrawn(case, 1, prior), tmp_path / "redrawn")) is None
+
+
+def test_how_often_the_truth_is_ranked_first_bounds_what_any_verdict_could_name():
+    """The verdict names a candidate or nothing: a case whose true effect no fit ranks first cannot be a hit
+    whatever the rules, so that share is the most the top-1 could reach on the same fits."""
+    ranked = [{"effect": "gravity"}, {"effect": "precurvature"}]
+    rows = [{**row("single", ["gravity"], "unexplained"), "above_detection_limit": True, "candidates": ranked},
+            {**row("single", ["precurvature"], "unexplained"), "above_detection_limit": True, "candidates": ranked},
+            {**row("single", ["gravity"], "gravity"), "above_detection_limit": False, "candidates": ranked},
+            {**row("single", ["gravity"], "gravity"), "above_detection_limit": True}]     # kept no candidates
+    result = score(rows)
+    assert result["truth_ranked_first_above_detection"] == 0.5
+    assert result["counts"]["single_above_detection_with_candidates"] == 2
+    assert result["top1_single_above_detection"] == pytest.approx(1 / 3)
