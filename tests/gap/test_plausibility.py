@@ -208,3 +208,25 @@ def test_hold_drift_is_measured_within_the_selection_half_only():
     assert hold_drift_rms_mm(f, np.zeros(len(f.motion), dtype=bool), errors)[1] == 0
     two_holds = np.arange(len(f.motion)) < 4 * 8
     assert hold_drift_reasons("rate_lag", f, two_holds, np.zeros_like(errors), errors, noise_mm=0.05) == []
+
+
+def test_a_fit_that_removes_most_of_the_residual_need_not_concentrate_in_its_signature_region():
+    """A large backlash on long sweeps stays taken up between reversals, a direction-dependent offset
+    over the whole sweep: its fit removes error everywhere, not mostly just after reversals. A fit that
+    removes half the error or more is most of the residual everywhere; a small gain outside its region
+    is still rejected."""
+    n = 200
+    motion = np.array(["after reversal"] * 40 + ["loading"] * 160)
+    f = SampleFeatures(np.full(n, 60.0), np.zeros(n), np.full(n, 80.0), motion, np.full(n, 3.0),
+                       np.linspace(1.0, 5.0, n), np.linspace(0, 1, n), np.zeros(n, dtype=int))
+    before = np.tile([1.0, 0.0, 0.0], (n, 1))
+    outside = motion != "after reversal"
+    most_removed_elsewhere = before.copy()
+    most_removed_elsewhere[outside] *= 0.2          # none of the gain after reversals, shrink 0.52
+    reasons, concentration = signature_reasons("backlash", f, before, most_removed_elsewhere)
+    shrink = 1.0 - np.sqrt(np.mean(np.sum(most_removed_elsewhere ** 2, axis=1)))
+    assert shrink >= 0.5 and concentration < MIN_SIGNATURE_CONCENTRATION and reasons == []
+    little_removed_elsewhere = before.copy()
+    little_removed_elsewhere[outside] *= 0.8
+    reasons, concentration = signature_reasons("backlash", f, before, little_removed_elsewhere)
+    assert concentration < MIN_SIGNATURE_CONCENTRATION and reasons and "after reversal" in reasons[0]
