@@ -185,6 +185,10 @@ def format_family_score(family: str, score: dict) -> str:
     if counts.get("single_above_detection_with_candidates"):
         lines.append("the true effect ranked first among the candidates above the detection limit, the most any "
                      f"verdict rule could name: {_count(score['truth_ranked_first_above_detection'], counts['single_above_detection_with_candidates'])}")
+    for kind, key in (("a clean", "largest_candidate_shrink_clean"),
+                      ("an out-of-catalog", "largest_candidate_shrink_out_of_catalog")):
+        if score.get(key) is not None:
+            lines.append(f"the largest share of the error any candidate removed on {kind} case: {score[key]:.2f}")
     if counts["out_of_catalog"]:
         lines.append(f"out-of-catalog cases 'unexplained': "
                      f"{_count(score['unexplained_out_of_catalog'], counts['out_of_catalog'])} (target >= 80 %); "

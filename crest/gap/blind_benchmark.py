@@ -23,7 +23,9 @@ curve, top-1 per effect against the effect's size relative to the baseline resid
 (`none` and `unexplained` both right); on out-of-catalog cases the share `unexplained` and the
 number with a catalog effect named; how often the true effect is the best-ranked candidate above
 the detection limit (the verdict names a candidate or nothing, so this bounds the top-1 that any
-verdict rule could reach on these fits); pair accuracy (dahl); and the error of the published shrink
+verdict rule could reach on these fits); the largest share of the error any candidate removed on
+clean and on out-of-catalog cases (what catalog effects can take up where the catalog holds
+nothing); pair accuracy (dahl); and the error of the published shrink
 against an oracle shrink on the same report half of the held-out log
 (`model.gap.holdout_split`), over the cases with an effect (clean cases are left out: their
 predicted and oracle shrink are both about 0, which would flatter the mean).
@@ -482,6 +484,8 @@ def score(all_rows: list[dict]) -> dict:
         "top1_single_above_visible_limit": fraction([r["predicted"] == r["truth"][0] for r in visible]),
         "truth_ranked_first_above_detection": fraction([r["candidates"][0]["effect"] == r["truth"][0]
                                                         for r in ranked]),
+        "largest_candidate_shrink_clean": _largest_shrink(clean),
+        "largest_candidate_shrink_out_of_catalog": _largest_shrink(outside),
         "visible_detection_curve": detection_curve(singles, "visible_relative_size"),
         "none_clean": fraction([r["predicted"] == "none" for r in clean]),
         "no_catalog_effect_clean": fraction([r["predicted"] in ("none", UNEXPLAINED) for r in clean]),
@@ -503,6 +507,14 @@ def score(all_rows: list[dict]) -> dict:
                    "skipped": len(all_rows) - len(rows), "no_result": sum("no_result" in r for r in rows)},
         "targets": TARGETS,
     }
+
+
+def _largest_shrink(rows: list[dict]) -> float | None:
+    """The largest selection-half shrink of any candidate on these cases (None without candidates kept):
+    how much catalog effects can take up where the catalog holds nothing (clean, out-of-catalog cases)."""
+    shrinks = [c["selection_shrink"] for r in rows for c in r.get("candidates", [])
+               if c.get("selection_shrink") is not None]
+    return max(shrinks) if shrinks else None
 
 
 def run_blind_benchmark(cases: int = 40, seed: int = 0, *, family: str = "dahl", short: bool = False,

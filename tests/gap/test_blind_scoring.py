@@ -112,3 +112,16 @@ def test_how_often_the_truth_is_ranked_first_bounds_what_any_verdict_could_name(
     assert result["truth_ranked_first_above_detection"] == 0.5
     assert result["counts"]["single_above_detection_with_candidates"] == 2
     assert result["top1_single_above_detection"] == pytest.approx(1 / 3)
+
+
+def test_the_largest_candidate_shrink_where_the_catalog_holds_nothing_is_kept_per_kind():
+    """How much catalog effects can take up on clean and out-of-catalog cases: the bound below which a
+    candidate's gain may be model form (`model.gap.plausibility.DOMINANT_SHRINK` must lie above it)."""
+    rows = [{**row("none", [], "unexplained"), "candidates": [{"selection_shrink": 0.12}, {"selection_shrink": None}]},
+            {**row("none", [], "none"), "candidates": [{"selection_shrink": 0.05}]},
+            {**row("out_of_catalog", ["stiffness_step"], "unexplained"), "candidates": [{"selection_shrink": 0.4}]},
+            {**row("single", ["backlash"], "backlash"), "candidates": [{"effect": "backlash", "selection_shrink": 0.9}]}]
+    result = score(rows)
+    assert result["largest_candidate_shrink_clean"] == 0.12
+    assert result["largest_candidate_shrink_out_of_catalog"] == 0.4
+    assert score([row("none", [], "none")])["largest_candidate_shrink_clean"] is None
