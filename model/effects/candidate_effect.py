@@ -26,8 +26,6 @@ class CandidateEffect:
     diagnosis knows, see model.gap.plausibility; "every region": it removes error everywhere), ""
     where the signature names no such region.
     apply: (terms, values) -> terms with this effect's fields set.
-    reduces_to: the simpler catalog effect this one becomes in a limit of its parameters ("" if
-    none): the diagnosis names the simpler one unless this one removes meaningfully more error.
     """
 
     id: str
@@ -39,7 +37,6 @@ class CandidateEffect:
     signature: str
     signature_region: str
     apply: Callable[[EffectTerms, tuple[float, ...]], EffectTerms]
-    reduces_to: str = ""
 
     def __post_init__(self) -> None:
         n = len(self.param_names)

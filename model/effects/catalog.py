@@ -100,8 +100,7 @@ EFFECTS: dict[str, CandidateEffect] = {e.id: e for e in (
         signature="the tip trails fast motion (error along the motion, growing with speed) and keeps creeping "
                   "without overshoot for ~tau after each stop; slow motion and settled holds agree",
         signature_region="fast",
-        apply=lambda t, v: t.replace(drive_creep_mm_per_n=v[0], drive_creep_time_s=v[1]),
-        reduces_to="tendon_elasticity"),   # tau -> 0: s = c*T_drive, an elastic drive line
+        apply=lambda t, v: t.replace(drive_creep_mm_per_n=v[0], drive_creep_time_s=v[1])),
 )}
 
 

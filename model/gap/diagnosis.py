@@ -8,8 +8,8 @@
    explain, both against the baseline and against its own ablation (the same fit with the
    effect switched off), and only if the baseline's error is significant against the tracker
    noise at all; else the verdict is `none` with a description of the unexplained residual.
-   Where the best found effect reduces to a simpler one that is found too, and is not
-   meaningfully better, the simpler one leads (`nested_candidates`). A second effect is added by
+   Where a found effect with fewer parameters explains about as much (the best is not
+   meaningfully better than it), the simplest such effect leads (`simplest_effect`). A second effect is added by
    greedy forward selection among the next best candidates found on their own, again only if the
    pair is meaningful against the control: the chosen effect refitted alone with the same budget.
 4. How far: held-out RMSE before and after, shrink overall and per region, and how the base
@@ -36,7 +36,7 @@ from model.gap.finite_json import finite_tree
 from model.gap.fit_pool import fit_pool, one_blas_thread
 from model.gap.free_parameters import base_values
 from model.gap.holdout_split import HoldoutSplit, split_holdout
-from model.gap.nested_candidates import simplest_sufficient
+from model.gap.simplest_effect import parameter_count, simplest_sufficient
 from model.gap.noise import tracker_noise_mm
 from model.gap.plausibility import hold_drift_reasons, range_reasons, signature_concentration, signature_reasons
 from model.gap.recording import Recording, RecordingError
@@ -182,11 +182,15 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
     pairs: list[CandidateResult] = []
     found_singles = [r for r in singles if not rejections(r)]
     eligible = simplest_sufficient(found_singles, noise)
-    simpler_than = []   # the richer found effect that scored higher but gave way (nested_candidates)
+    simpler_than = []   # the richer found effect that scored higher but gave way (simplest_effect)
     if eligible and eligible[0] is not found_singles[0]:
-        simpler_than = [{"effect": found_singles[0].effects[0],
-                         "reason": f"{found_singles[0].effects[0]} reduces to {eligible[0].effects[0]} and removes no "
-                                   "more error than noise and fitting freedom explain"}]
+        richer, simpler = found_singles[0], eligible[0]
+        simpler_than = [{"effect": richer.effects[0],
+                         "reason": f"{richer.effects[0]} has {parameter_count(richer)} free parameters, "
+                                   f"{simpler.effects[0]} {parameter_count(simpler)}, and {richer.effects[0]} removes "
+                                   f"no more error than noise and fitting freedom explain beyond it "
+                                   f"({simpler.holdout_rmse_mm:.3f} -> {richer.holdout_rmse_mm:.3f} mm on the "
+                                   "selection half)"}]
         say(f"{eligible[0].effects[0]} leads: {simpler_than[0]['reason']}")
     if eligible and settings.pair_candidates == 0:
         chosen = [eligible[0]]
