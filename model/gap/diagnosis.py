@@ -9,9 +9,10 @@
    effect switched off), and only if the baseline's error is significant against the tracker
    noise at all; else the verdict is `none` with a description of the unexplained residual.
    Where a found effect with fewer parameters explains about as much (the best is not
-   meaningfully better than it), the simplest such effect leads (`simplest_effect`). A second effect is added by
-   greedy forward selection among the next best candidates found on their own, again only if the
-   pair is meaningful against the control: the chosen effect refitted alone with the same budget.
+   meaningfully better than it), the simplest such effect leads (`simplest_effect`). A second
+   effect is added by greedy forward selection among the next best candidates found on their
+   own, again only if the pair is meaningful against the control: the chosen effect refitted
+   alone with the same budget.
 4. How far: held-out RMSE before and after, shrink overall and per region, and how the base
    parameters moved when the effect was added.
 The result is a plain, JSON-able dict (see `diagnose`).
@@ -36,7 +37,6 @@ from model.gap.finite_json import finite_tree
 from model.gap.fit_pool import fit_pool, one_blas_thread
 from model.gap.free_parameters import base_values
 from model.gap.holdout_split import HoldoutSplit, split_holdout
-from model.gap.simplest_effect import parameter_count, simplest_sufficient
 from model.gap.noise import tracker_noise_mm
 from model.gap.plausibility import hold_drift_reasons, range_reasons, signature_concentration, signature_reasons
 from model.gap.recording import Recording, RecordingError
@@ -44,6 +44,7 @@ from model.gap.regions import breakdown, concentrated, regions, shrink_by_region
 from model.gap.sample_features import SampleFeatures, compute_features
 from model.gap.significance import is_meaningful, is_significant_residual, model_form_rms_mm, nothing_to_explain
 from model.gap.signatures import describe, signatures
+from model.gap.simplest_effect import parameter_count, simplest_sufficient
 from model.gap.simulation import Resolution, predict_tips, predict_tips_and_tension
 from model.gap.starting_points import start_values
 from model.params import CatheterParams
