@@ -33,12 +33,20 @@ def is_meaningful(rmse_before_mm: float, rmse_after_mm: float, noise_mm: float |
                                                 MIN_EXCESS_FRACTION * (rmse_before_mm ** 2 - floor))
 
 
-RESIDUAL_EXCESS = 0.5             # a residual is significant when its squared RMSE exceeds the floor by half
+RESIDUAL_EXCESS = 0.3             # a residual is significant when its squared RMSE exceeds the floor by 30 %
 
 
 def is_significant_residual(rmse_mm: float, noise_mm: float | None) -> bool:
     """Is a held-out error more than the tracker noise can explain: rmse^2 >= (1 + RESIDUAL_EXCESS) f^2
-    with f^2 = 3 sigma^2 (rmse >= 1.22 f)? Without a noise estimate the data cannot tell: False."""
+    with f^2 = 3 sigma^2 (rmse >= 1.14 f)? Without a noise estimate the data cannot tell: False.
+
+    Since every log starts with no friction stored (`control.excitation`, f7f6e4e), the Dahl
+    family's clean cases leave 0.96-1.13 floors on the selection half (ten re-recorded cases of
+    seeds 55-73), where before their first static hold's tip offset put them at up to 1.24 and let
+    a precurvature absorb it. Three true effects re-recorded then (an elastic line and a rate lag
+    at 1.17-1.20 floors, whose fits removed 0.14-0.24 of the error) were refused by the margin of
+    0.5 (1.22 floors) that had been set with the offset in the logs.
+    """
     if noise_mm is None or not np.isfinite(rmse_mm):
         return False
     return rmse_mm ** 2 >= (1.0 + RESIDUAL_EXCESS) * 3.0 * noise_mm ** 2
