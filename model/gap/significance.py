@@ -41,11 +41,11 @@ def is_significant_residual(rmse_mm: float, noise_mm: float | None) -> bool:
     with f^2 = 3 sigma^2 (rmse >= 1.14 f)? Without a noise estimate the data cannot tell: False.
 
     Since every log starts with no friction stored (`control.excitation`, f7f6e4e), the Dahl
-    family's clean cases leave 0.96-1.13 floors on the selection half (ten re-recorded cases of
-    seeds 55-73), where before their first static hold's tip offset put them at up to 1.24 and let
-    a precurvature absorb it. Three true effects re-recorded then (an elastic line and a rate lag
-    at 1.17-1.20 floors, whose fits removed 0.14-0.24 of the error) were refused by the margin of
-    0.5 (1.22 floors) that had been set with the offset in the logs.
+    family's clean cases leave 0.96-1.13 floors on the selection half (eleven cases of seeds 55-73:
+    nine re-recorded, seed 73's two), where before their first static hold's tip offset put them at
+    up to 1.24 and let a precurvature absorb it. Three true effects recorded then (two elastic lines
+    and a rate lag at 1.17-1.20 floors, whose fits removed 0.14-0.24 of the error) were refused by
+    the margin of 0.5 (1.22 floors) that had been set with the offset in the logs.
     """
     if noise_mm is None or not np.isfinite(rmse_mm):
         return False
