@@ -56,6 +56,11 @@ samples; report_rmse_mm and report_shrink: on the report half (see module doc).
 
     ablated_*: the fit's base parameters with the effects switched off (training RMSE and
     held-out errors; inf and () when not computed).
+
+    started_from: the base-only fit it started from, "calibration" or "better baseline" (see
+    `model.gap.diagnosis.better_start`); train_rmse_mm_by_start: the training RMSE the fit reached
+    from each start, where it was fitted from both (empty otherwise); a control refit of the
+    verdict's effect may go lower still.
     """
 
     effects: tuple[str, ...]
@@ -70,6 +75,8 @@ samples; report_rmse_mm and report_shrink: on the report half (see module doc).
     seconds: float = 0.0
     ablated_train_rmse_mm: float = math.inf
     ablated_holdout_errors: tuple[np.ndarray, ...] = ()
+    started_from: str = "calibration"
+    train_rmse_mm_by_start: dict = dataclasses.field(default_factory=dict)
 
     @property
     def failed(self) -> bool:
@@ -100,7 +107,8 @@ samples; report_rmse_mm and report_shrink: on the report half (see module doc).
                 "ablated_holdout_rmse_mm": number(rmse_mm(self.ablated_holdout_errors))
                 if self.ablated_holdout_errors else None,
                 "diverged": self.failed, "flags": list(self.fit.flags),
-                "model_runs": self.fit.model_runs, "seconds": self.seconds}
+                "model_runs": self.fit.model_runs, "seconds": self.seconds, "started_from": self.started_from,
+                "train_rmse_mm_by_start": {start: number(rmse) for start, rmse in self.train_rmse_mm_by_start.items()}}
 
 
 EXPLORE = "explore"     # single candidates and the plain refit: four starts, explored

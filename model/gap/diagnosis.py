@@ -53,6 +53,9 @@ FORMAT = "crest-gap/2"
 UNEXPLAINED = "unexplained"
 
 
+REFITS_FROM_BETTER_BASE = 3   # candidates fitted again when a base-only fit beats the calibration
+
+
 @dataclass(frozen=True)
 class DiagnosisSettings:
     """How the diagnosis runs. workers: parallel candidate fits; pair_candidates: how many of the
@@ -130,13 +133,20 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
         (r.ablated(), list(r.ablated_holdout_errors)) for r in singles]
     best_base, best_errors = min([(fit, errors) for fit, errors in bases if np.isfinite(rmse_mm(errors))],
                                  key=lambda pair: pair[0].train_rmse_mm)
+    improved_by = None
     if best_base is not baseline:
+        improved_by = "the plain refit" if best_base is refit.fit else "a candidate with its effect switched off"
         say(f"baseline: improved from {baseline.train_rmse_mm:.4f} to {best_base.train_rmse_mm:.4f} mm (training; "
-            f"{'the plain refit' if best_base is refit.fit else 'a candidate with its effect switched off'})")
+            f"{improved_by})")
         baseline, base_errors = best_base, best_errors
         singles = [replace(evaluate(r.effects, r.fit, r.holdout_errors, base_errors, split), seconds=r.seconds,
                            ablated_train_rmse_mm=r.ablated_train_rmse_mm,
                            ablated_holdout_errors=r.ablated_holdout_errors) for r in singles]
+        # A fit's minimum depends on where it starts: the best candidates again from the better base
+        again = [r.effects[0] for r in ranked(singles)[:REFITS_FROM_BETTER_BASE]]
+        say(f"candidates: {', '.join(again)} again from the better baseline")
+        refits = {r.effects: r for r in run_tasks([task({i: start_values(i)}, baseline) for i in again], pool)}
+        singles = [better_start(r, refits.get(r.effects)) for r in singles]
     singles = ranked(singles)
     base_rmse = rmse_mm(base_errors)
     timing["candidates"] = time.perf_counter() - clock - sum(timing.values())
@@ -206,7 +216,9 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
                                          for other in others], pool)
         # the control got further: it is the single, if it still predicts and still is a found effect
         if continued.fit.train_rmse_mm < best.fit.train_rmse_mm and not rejections(continued):
-            singles[singles.index(best)] = best = replace(continued, seconds=best.seconds + continued.seconds)
+            singles[singles.index(best)] = best = replace(continued, seconds=best.seconds + continued.seconds,
+                                                          started_from=best.started_from,
+                                                          train_rmse_mm_by_start=best.train_rmse_mm_by_start)
         chosen = [best]
         pairs = ranked(pairs)
         if pairs and not rejections(pairs[0], best):
@@ -258,7 +270,7 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
                      "report_rmse_mm": base_report_rmse, "noise_mm": noise,
                      "noise_floor_mm": None if noise is None else float(np.sqrt(3) * noise),
                      "residual_significant": is_significant_residual(base_rmse, noise),
-                     "fit": baseline.as_dict()},
+                     "improved_by": improved_by, "fit": baseline.as_dict()},
         "constant_curvature": {**reference.as_dict(), "holdout_rmse_mm": rmse_mm(reference_errors),
                                "report_rmse_mm": rmse_mm(split.reported(reference_errors))},
         "holdout_by_recording": [
@@ -282,6 +294,22 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
     }
     result, nulls = finite_tree(result)
     return {**result, "non_finite": nulls}
+
+
+def better_start(first: CandidateResult, again: CandidateResult | None) -> CandidateResult:
+    """The candidate fitted from the calibration (`first`) or again from the better baseline (`again`,
+    None: not fitted again), whichever fits the training recordings better, with both training RMSEs.
+
+    On a rod log (seed 86, case 8) a precurvature fitted from the calibration removed 0.09 of the
+    selection half's error; from the base-only fit that had beaten the calibration it removed 0.22
+    and was found, where the withheld truth was that precurvature.
+    """
+    if again is None:
+        return first
+    kept = again if again.fit.train_rmse_mm < first.fit.train_rmse_mm else first
+    return replace(kept, started_from="better baseline" if kept is again else "calibration",
+                   train_rmse_mm_by_start={"calibration": first.fit.train_rmse_mm,
+                                           "better baseline": again.fit.train_rmse_mm})
 
 
 def _concentration(result: CandidateResult, features: SampleFeatures, split: HoldoutSplit,
