@@ -4,7 +4,9 @@
    beside calibrated constant curvature (`cc_calibration`), the reference it must beat.
 2. Where: break the held-out residual down by region (`regions`) and compute its signatures.
 3. Which: fit every candidate effect (and a plain refit, the control) in parallel, rank them by
-   held-out score (`candidates`); the best is chosen only if it removes more than noise can
+   held-out score (`candidates`). Where a base-only fit (the refit, or a candidate with its effect
+   switched off) fits the training recordings better than the calibration, it becomes the
+   baseline and the best candidates are fitted again from it (`better_start`). The best is chosen only if it removes more than noise can
    explain, both against the baseline and against its own ablation (the same fit with the
    effect switched off), and only if the baseline's error is significant against the tracker
    noise at all; else the verdict is `none` with a description of the unexplained residual.
