@@ -1,7 +1,9 @@
 """Session set-up shared by every test.
 
 The numba kernels (the model's and the rod plant's) are compiled once, before pytest-xdist starts
-its workers (`pytest_configure`).
+its workers (`pytest_configure`). The controller also makes the run's shared folder
+($CREST_TEST_SHARED_DIR, removed at the end), where a result that several workers need is computed
+once (tests.gap.conftest.diagnosed).
 
 Every test gets a runtime folder of its own for the served virtual testbed's state file. A
 real-time crest command that finds no served testbed starts one (crest.testbed_service); the
@@ -10,7 +12,13 @@ test from joining a testbed another test (or the user's own `crest testbed serve
 """
 from __future__ import annotations
 
+import os
+import shutil
+import tempfile
+
 import pytest
+
+SHARED_DIR_VARIABLE = "CREST_TEST_SHARED_DIR"
 
 
 def pytest_configure(config):
@@ -23,6 +31,7 @@ def pytest_configure(config):
     """
     if hasattr(config, "workerinput") or not config.getoption("numprocesses", default=None):
         return      # an xdist worker (the controller has compiled them), or one process: it compiles as it goes
+    os.environ[SHARED_DIR_VARIABLE] = tempfile.mkdtemp(prefix="crest-tests-")     # the workers inherit it
     from model import CatheterParams, ConstantCurvature, DahlCatheter
     from sim_backend.plant.rod.rod_plant import RodPlant
     params, pull_mm = CatheterParams.from_toml(), [0.5, 0.0, 0.0, 0.0]
@@ -32,6 +41,11 @@ def pytest_configure(config):
     ConstantCurvature(params).tip_mm(pull_mm, 50.0)
     ConstantCurvature(params).backbone_mm(pull_mm, 50.0)
     RodPlant().step(0.01, pull_mm, 0.0)
+
+
+def pytest_unconfigure(config):
+    if not hasattr(config, "workerinput") and SHARED_DIR_VARIABLE in os.environ:
+        shutil.rmtree(os.environ.pop(SHARED_DIR_VARIABLE), ignore_errors=True)
 
 
 @pytest.fixture(autouse=True)

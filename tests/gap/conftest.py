@@ -1,7 +1,10 @@
 """Short, fixed-seed gap cases: a model plant records the short excitation, the diagnosis reads the logs."""
 from __future__ import annotations
 
+import fcntl
 import functools
+import os
+import pickle
 import tempfile
 from pathlib import Path
 
@@ -16,6 +19,7 @@ from model import CatheterParams
 from model.effects import EFFECTS
 from model.gap.diagnosis import DiagnosisSettings
 from model.gap.simulation import Resolution
+from tests.conftest import SHARED_DIR_VARIABLE
 
 # Coarser and shorter than the defaults, so that ten diagnoses fit in the test budget.
 TEST_SETTINGS = DiagnosisSettings(resolution=Resolution(n_elements=6, fit_rate_hz=5.0), baseline_iterations=25,
@@ -47,7 +51,23 @@ def record_case(folder: Path, effects: dict, seed: int = 1, noise_mm: float = 0.
 
 @functools.cache
 def diagnosed(effect_id: str | None) -> dict:
-    """The diagnosis of the fixed-seed case with this effect (None: clean), computed once per session."""
+    """The diagnosis of the fixed-seed case with this effect (None: clean), computed once per test run.
+
+    Under pytest-xdist the tests that read one diagnosis may run on different workers: the first to
+    ask computes it, holding a lock on its file in the run's shared folder (tests/conftest.py), and
+    the others wait on that lock and read the file. Run alone, it is computed once per process."""
+    shared = os.environ.get(SHARED_DIR_VARIABLE)
+    if shared is None:
+        return _diagnosis(effect_id)
+    path = Path(shared) / f"diagnosis-{effect_id or 'clean'}.pickle"
+    with open(path.with_suffix(".lock"), "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not path.is_file():
+            path.write_bytes(pickle.dumps(_diagnosis(effect_id)))
+        return pickle.loads(path.read_bytes())
+
+
+def _diagnosis(effect_id: str | None) -> dict:
     with tempfile.TemporaryDirectory() as folder:
         train, holdout = record_case(Path(folder), {} if effect_id is None else {effect_id: None})
         return diagnose_logs([train], [holdout], settings=TEST_SETTINGS)
