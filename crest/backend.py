@@ -57,6 +57,7 @@ class Backend:
     owned: OwnedTestbed | None = None     # ... when this process started it for itself
     stamp_answers: StampAnswers | None = None   # ... when it runs in simulated time
     clock_lock_fd: int | None = None            # ... whose clock this process alone drives
+    plant: str | None = None        # the virtual testbed's plant, one line (plant_summary); None on hardware
 
     @property
     def is_virtual(self) -> bool:
@@ -213,7 +214,8 @@ def _joined(config: TestbedConfig, served: ServedTestbed) -> Backend:
     """The backend of a served testbed, joined; in simulated time its bus hands every frame to the
     answers of the TIME stamps (sim_backend.time_stamps)."""
     bus = HookedBus(_join_served(config, served))
-    backend = Backend(bus=bus, tracker_port=served.tracker_port, served=served)
+    backend = Backend(bus=bus, tracker_port=served.tracker_port, served=served,
+                      plant=served.plant or "not said (a testbed served by an older crest)")
     if served.simulated_time:
         backend.stamp_answers = StampAnswers()
         bus.receive_hooks = [backend.stamp_answers.on_frame]
@@ -269,7 +271,8 @@ def _open_virtual(config: TestbedConfig, plant_spec: str | None, plant_toml: Pat
                                tracker_noise_mm, tracker_dropout)
     testbed.start(realtime=realtime)
     bus = HookedBus(can.Bus(interface="virtual", channel=channel, receive_own_messages=False))
-    return Backend(bus=bus, tracker_port=testbed.tracker_port, virtual=testbed)
+    return Backend(bus=bus, tracker_port=testbed.tracker_port, virtual=testbed,
+                   plant=plant_summary(plant_spec, plant_toml, effects))
 
 
 @dataclass
@@ -367,6 +370,23 @@ def plant_from_description(plant_toml: Path | None, effects: dict | None = None)
     from sim_backend.plant.plant_description import load_plant_description
 
     return load_plant_description(plant_toml, effects)[0]
+
+
+def plant_summary(plant: str | None, plant_config: Path | None, effects: dict | None = None) -> str:
+    """What the virtual testbed simulates behind its drives, in one line, and whether a result on it
+    says anything beyond the controller's own model: the Dahl family runs `model`'s own kernel with
+    other parameters (a result on it is in family); the rod family shares no code with `model`
+    (out of family). A plant class given as MODULE:CLASS is named as given."""
+    added = f" with {', '.join(sorted(effects))}" if effects else ""
+    if plant:
+        return f"{plant}{added} (--plant: a plant class of your own)"
+    if plant_description_family(plant_config) == "rod":
+        return (f"rod family ({plant_config}){added}: a Kirchhoff rod written independently of the controller's "
+                "model, so results on it are out of family")
+    from sim_backend.plant.dahl_plant import DEFAULT_PLANT_TOML
+
+    return (f"Dahl family ({plant_config or DEFAULT_PLANT_TOML}){added}: the controller's own model with other "
+            "parameters, so results on it are in family (configs/rod_plant.toml is the independent rod plant)")
 
 
 def plant_description_refusal(plant_toml: Path) -> str | None:

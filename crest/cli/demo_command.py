@@ -2,7 +2,9 @@
 
 Boots the five simulated drives, homes, and runs the paper's circle scenario (Fig. 4.3) twice,
 with the constant-curvature controller and with the friction-aware Dahl feedforward, recording
-both runs. The virtual catheter differs from the controller's model like a real one would.
+both runs. On the virtual testbed it says which plant runs behind the drives: by default the Dahl
+family, the controller's own model with other parameters (an in-family comparison);
+`--plant-config configs/rod_plant.toml` runs it on the independent rod plant (out of family).
 """
 from __future__ import annotations
 
@@ -45,6 +47,9 @@ def run(args: argparse.Namespace) -> int:
         where = "the virtual testbed" if session.backend.is_virtual else "the testbed"
         print(f"booted 5 axes on {where} ({config.bus.interface}:{config.bus.channel}, "
               f"SYNC {1 / period_s:.0f} Hz)")
+        plant = session.backend.plant
+        if plant is not None:
+            print(f"plant: {plant}")
         session.testbed.home()
         print("homed; running the paper's circle (Fig. 4.3) at "
               f"{DEMO_ARTICULATION_DEG:.0f} deg articulation, {DEMO_INSERTION_MM:.0f} mm free length")
@@ -65,6 +70,6 @@ def run(args: argparse.Namespace) -> int:
               f"samples" + (f"; {lost}" if lost else "") + f"; log {result.log_path}")
     cc, dahl = results["cc"].rms_tip_error_mm, results["dahl"].rms_tip_error_mm
     print(f"the friction-aware feedforward cuts the tip error by {100 * (1 - dahl / cc):.0f}% "
-          "against constant curvature")
+          "against constant curvature" + (f"\n  on the plant: {plant}" if plant is not None else ""))
     print(f"logs are in {out_dir}/ (CSV + JSON sidecar + CAN traffic .blf)")
     return 0

@@ -1,4 +1,5 @@
-"""`crest status`: a table of the axes (NMT state, CiA 402 state, position, following error, fault)."""
+"""`crest status`: a table of the axes (NMT state, CiA 402 state, position, following error, fault), and on the
+virtual testbed the plant behind the drives."""
 from __future__ import annotations
 
 import argparse
@@ -23,6 +24,8 @@ def run(args: argparse.Namespace) -> int:
     with open_session(session_options(args, boot=False, tracker=False)) as session:
         time.sleep(HEARTBEAT_WAIT_S)   # learn each drive's NMT state from its heartbeat
         print(format_status(session.testbed.status()))
+        if session.backend.plant is not None:
+            print(f"plant: {session.backend.plant}")
     return 0
 
 

@@ -77,6 +77,7 @@ def _announce(served, state_file: Path) -> None:
     print(f"crest testbed serve: the virtual testbed of {served.config} is running (pid {served.pid})\n"
           f"  CAN bus:    python-can interface '{served.bus_interface}', channel '{served.bus_channel}'\n"
           f"  tracker:    {served.tracker_port}\n"
+          f"  plant:      {served.plant}\n"
           f"  state file: {state_file}\n"
           + (f"  CPU:        {', '.join(map(str, served.cpus))} (the commands that join it run on the others)\n"
              if served.cpus else "")

@@ -30,7 +30,7 @@ import threading
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from crest.backend import serve_virtual_testbed
+from crest.backend import plant_summary, serve_virtual_testbed
 from crest.config import TestbedConfig
 from crest.driver.realtime_scheduling import realtime_threads
 from crest.testbed_service.cpu_split import pin_process, testbed_cpus
@@ -67,7 +67,8 @@ def serve_until_stopped(config: TestbedConfig, *, plant: str | None = None, plan
                                    bus_channel=server.bus_channel, tracker_port=server.tracker_port,
                                    config=str(Path(config.path).resolve()), config_digest=config_digest(config),
                                    simulated_time=simulated_time, cpus=cpus,
-                                   scheduling=scheduling.describe())
+                                   scheduling=scheduling.describe(),
+                                   plant=plant_summary(plant, plant_config, effects))
             publish(served)
             on_ready(served, state_path())
             gc.freeze()     # what serving needs for good: out of the collector's full passes (module doc)

@@ -42,7 +42,8 @@ CLAIM_RETRY_S = 1.0     # a command looking at the lock holds it for an instant;
 @dataclass(frozen=True)
 class ServedTestbed:
     """A running served testbed: its process, its CAN bus (python-can interface and channel), its
-    tracker's serial port and the testbed configuration it serves."""
+    tracker's serial port, the testbed configuration it serves and the plant behind its drives (one
+    line, `crest.backend.plant_summary`; empty in the state of a testbed served by an older crest)."""
 
     pid: int
     bus_interface: str
@@ -53,6 +54,7 @@ class ServedTestbed:
     simulated_time: bool = False
     cpus: tuple[int, ...] = ()
     scheduling: str = "normal scheduler"
+    plant: str = ""
 
     def describe(self) -> str:
         return (f"pid {self.pid}, CAN bus interface '{self.bus_interface}' channel '{self.bus_channel}', "

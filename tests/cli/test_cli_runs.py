@@ -25,6 +25,10 @@ def test_demo_boots_homes_runs_the_paper_circle_and_records(tmp_path):
     result = crest("demo", "--fast", "--record", str(tmp_path))
     assert result.returncode == 0, result.stderr
     assert "booted 5 axes" in result.stdout and "homed" in result.stdout
+    # the comparison says it ran on the controller's own model (the default Dahl plant): in family
+    assert "plant: Dahl family" in result.stdout
+    summary = result.stdout.split("the friction-aware feedforward cuts the tip error by")[1]
+    assert "on the plant: Dahl family" in summary and "in family" in summary
     logs = sorted(tmp_path.glob("demo-*/circle-*.csv"))
     assert [log.stem for log in logs] == ["circle-cc", "circle-dahl"]
     for path in logs:
