@@ -21,6 +21,7 @@ from crest.gap.fit_executor import check_scheduler_address, dask_executor, open_
 from crest.gap.log_diagnosis import diagnose_logs
 from crest.gap.log_recordings import load_recordings
 from crest.gap.real_data_table import real_data_table, table_markdown
+from crest.log import recorded_plant
 from crest.reports.blind_report import write_blind_report
 from crest.reports.gap_report import sampling_lines, write_gap_report
 from model.gap.diagnosis import DiagnosisSettings
@@ -107,17 +108,30 @@ def run(args: argparse.Namespace) -> int:
     if not args.train or not args.holdout:
         raise ValueError("give training logs and --holdout logs (recorded on other trajectories), "
                          "e.g. `crest gap train.csv --holdout test.csv`")
+    plants = {str(path): recorded_plant(path) for path in [*args.train, *args.holdout]}   # bad logs refused here
     with open_executor(args.scheduler, args.workers) as executor:
         if args.scheduler:
             _progress(f"fits run on the Dask cluster at {args.scheduler}")
         result = diagnose_logs(args.train, args.holdout, args.catheter, settings, progress=_progress,
                                executor=executor)
+    result["log_plants"] = plants
     _write_json(result, args.json_path)
     if args.report:
         path = write_gap_report(result, load_recordings(args.holdout), args.report)
         print(f"report written to {path}")
     print(format_verdict(result))
+    print(plant_lines(plants))
     return 0
+
+
+def plant_lines(plants: dict[str, str | None]) -> str:
+    """Where the logs came from, as their sidecars say: the virtual testbed's plant and its family (a
+    score on the Dahl family is in family, on the rod family out of family), or none named."""
+    named = sorted({plant for plant in plants.values() if plant is not None})
+    lines = [f"logs recorded on the virtual testbed, plant: {plant}" for plant in named]
+    if None in plants.values():
+        lines.append("logs with no plant in their sidecar: hardware, imported, or recorded before crest kept it")
+    return "\n".join(lines)
 
 
 def _write_json(result: dict, path: Path | None) -> None:

@@ -50,7 +50,7 @@ class ExperimentRecorder:
                                              outer_diameter_mm=catheter.outer_diameter_mm),
             sample_rate_hz=1.0 / config.sync.period_s, tendon_force=True, tip_ref=tip_ref,
             source=f"crest {__version__}, {'virtual testbed' if session.backend.is_virtual else 'hardware'}: {source}",
-            notes=notes, config=config.as_dict(), overwrite=overwrite)
+            notes=notes, config=config.as_dict(), plant=session.backend.plant, overwrite=overwrite)
         self.bus_log_path = csv_path.with_suffix(".blf")
         self.bus = BusRecorder(self.bus_log_path)
         self._host_bus = session.backend.bus

@@ -2,7 +2,7 @@
 
 from crest.log.bus_recorder import BusRecorder
 from crest.log.log_format import FORMAT_TAG, LogFormatError, TruncatedLogWarning, catheter_dict, sidecar_path
-from crest.log.log_reader import ExperimentLog, read_log
+from crest.log.log_reader import ExperimentLog, read_log, recorded_plant
 from crest.log.log_writer import LogWriter
 
 __all__ = [
@@ -14,5 +14,6 @@ __all__ = [
     "TruncatedLogWarning",
     "catheter_dict",
     "read_log",
+    "recorded_plant",
     "sidecar_path",
 ]

@@ -35,7 +35,8 @@ JSON sidecar: same stem, suffix ``.json``:
                   "tendon_offset_mm": >0, "tendon_angles_deg": [4 numbers]},
      "sample_rate_hz": >0, "source": "...", "notes": "..."}
 Further keys are allowed (the writer adds ``config``, ``software``, ``created_utc``, ``columns``,
-``units`` and, at close, ``summary``). ``units`` maps each column of the header to its unit
+``units``, on the virtual testbed ``plant`` (what it simulated behind the drives, and whether that is
+the controller's own model: in or out of family) and, at close, ``summary``). ``units`` maps each column of the header to its unit
 (COLUMN_UNITS: "s", "mm" or "N"), e.g. ``{"t": "s", "tendon_cmd_1": "mm", "tendon_force_1": "N"}``;
 it is optional (older logs lack it), and when present every entry must name a known column with
 the unit this format fixes for it.
@@ -148,6 +149,8 @@ def check_sidecar(sidecar: Any, path: Path) -> dict[str, Any]:
         _check_positive(catheter["outer_diameter_mm"], path, "catheter.outer_diameter_mm")
     if "units" in sidecar:
         _check_units(sidecar["units"], path)
+    if "plant" in sidecar and not isinstance(sidecar["plant"], str):
+        raise LogFormatError(path, f"'plant' must be a JSON string (the virtual testbed's plant), got {sidecar['plant']!r}")
     angles = catheter.get("tendon_angles_deg")
     if (not isinstance(angles, list) or len(angles) != 4
             or not all(_is_number(angle) and math.isfinite(angle) for angle in angles)):

@@ -66,9 +66,20 @@ class ExperimentLog:
         return len(self.t_s)
 
     @property
+    def plant(self) -> str | None:
+        """What the virtual testbed simulated behind the drives, with its family (None: a log of hardware,
+        imported, or written before crest kept it)."""
+        return self.sidecar.get("plant")
+
+    @property
     def tip_valid(self) -> np.ndarray:
         """Boolean mask [T] of rows with a tracker sample."""
         return np.all(np.isfinite(self.tip_mm), axis=1)
+
+
+def recorded_plant(csv_path: Path | str) -> str | None:
+    """`ExperimentLog.plant` from the log's sidecar alone (the rows are not read)."""
+    return _read_sidecar(_existing_log(csv_path)).get("plant")
 
 
 def read_log(csv_path: Path | str) -> ExperimentLog:
@@ -76,9 +87,7 @@ def read_log(csv_path: Path | str) -> ExperimentLog:
 
     A last line without its newline (a killed writer) is dropped with a TruncatedLogWarning.
     """
-    path = Path(csv_path)
-    if not path.is_file():
-        raise LogFormatError(path, "no such file" if not path.exists() else "not a file (a crest log is a .csv file)")
+    path = _existing_log(csv_path)
     sidecar = _read_sidecar(path)
     columns, rows = _read_rows(path)
     by_name = {name: position for position, name in enumerate(columns)}
@@ -116,6 +125,13 @@ def _read_only(array: np.ndarray) -> np.ndarray:
 
 def _refuse_constant(name: str) -> None:
     raise ValueError(f"{name} is not valid JSON; write null for a missing value")
+
+
+def _existing_log(csv_path: Path | str) -> Path:
+    path = Path(csv_path)
+    if not path.is_file():
+        raise LogFormatError(path, "no such file" if not path.exists() else "not a file (a crest log is a .csv file)")
+    return path
 
 
 def _read_sidecar(csv_path: Path) -> dict[str, Any]:

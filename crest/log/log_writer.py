@@ -63,14 +63,16 @@ class LogWriter:
     """Write one experiment log: ``LogWriter(path, catheter=..., sample_rate_hz=..., source=...)``.
 
     ``catheter`` is the sidecar's catheter object (see `log_format.catheter_dict`); ``config`` a
-    JSON-able configuration snapshot (e.g. ``TestbedConfig.as_dict()``); ``tendon_force`` and
+    JSON-able configuration snapshot (e.g. ``TestbedConfig.as_dict()``); ``plant`` what the virtual
+    testbed simulated behind the drives (`crest.backend.plant_summary`; None, and no key, on
+    hardware); ``tendon_force`` and
     ``tip_ref`` add the optional column groups. An existing log is not overwritten unless
     ``overwrite`` is true. Thread-safe: a safety stop may flush or close from another thread.
     """
 
     def __init__(self, csv_path: Path | str, *, catheter: Mapping[str, Any], sample_rate_hz: float,
                  source: str, notes: str = "", tendon_force: bool = False, tip_ref: bool = False,
-                 config: Mapping[str, Any] | None = None, overwrite: bool = False,
+                 config: Mapping[str, Any] | None = None, plant: str | None = None, overwrite: bool = False,
                  flush_interval_s: float = DEFAULT_FLUSH_INTERVAL_S,
                  clock: Callable[[], float] = time.monotonic) -> None:
         if not (math.isfinite(flush_interval_s) and 0.0 < flush_interval_s <= DEFAULT_FLUSH_INTERVAL_S):
@@ -108,6 +110,8 @@ class LogWriter:
             "software": {"crest_version": software_version(), "python": platform.python_version()},
             "config": None if config is None else dict(config),
         }
+        if plant is not None:
+            self._sidecar["plant"] = plant
         check_sidecar(self._sidecar, self.sidecar_path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         _write_json_atomically(self.sidecar_path, self._sidecar)

@@ -34,6 +34,7 @@ def test_demo_boots_homes_runs_the_paper_circle_and_records(tmp_path):
     for path in logs:
         log = read_log(path)
         assert len(log) > 1000 and log.tip_ref_mm is not None and log.tendon_force_n is not None
+        assert log.plant.startswith("Dahl family") and "in family" in log.plant
         assert path.with_suffix(".blf").stat().st_size > 0
         frames = list(can.LogReader(path.with_suffix(".blf")))
         assert any(frame.arbitration_id == 0x80 for frame in frames)      # SYNC was recorded

@@ -76,7 +76,11 @@ def test_crest_gap_runs_its_fits_on_the_scheduler(cluster, tmp_path):
     assert run.returncode == 0, run.stderr
     assert f"fits run on the Dask cluster at {address}" in run.stderr
     assert "verdict: backlash" in run.stdout
-    assert json.loads((tmp_path / "gap.json").read_text())["verdict"]["effect"] == "backlash"
+    result = json.loads((tmp_path / "gap.json").read_text())
+    assert result["verdict"]["effect"] == "backlash"
+    # the logs come from a model plant written straight to files: no virtual testbed's plant in their sidecars
+    assert result["log_plants"] == {str(train): None, str(holdout): None}
+    assert "logs with no plant in their sidecar" in run.stdout
     # the scheduler ran the candidate fits (it keeps per-task-name statistics after the tasks are gone)
     prefixes = client.run_on_scheduler(lambda dask_scheduler: sorted(dask_scheduler.task_prefixes))
     assert "run_task" in prefixes and "calibrate" in prefixes, prefixes

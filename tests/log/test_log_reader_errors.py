@@ -83,6 +83,7 @@ def test_malformed_body_names_line_and_column(tmp_path: Path, body: str, line: i
     ({"catheter": {**SIDECAR["catheter"], "tendon_angles_deg": [0, 90, 180]}}, "tendon_angles_deg"),
     ({"catheter": {**SIDECAR["catheter"], "tendon_offset_mm": -1}}, "tendon_offset_mm"),
     ({"notes": None}, "'notes' must be a JSON string"),
+    ({"plant": {"family": "rod"}}, "'plant' must be a JSON string"),
 ])
 def test_bad_sidecar_is_named(tmp_path: Path, change: dict, problem: str):
     path = _log(tmp_path, f"{HEADER}\n{ROW_0}\n", {**SIDECAR, **change})

@@ -1,6 +1,8 @@
 """The rod family through the CLI, as a user runs it: `--plant-config configs/rod_plant.toml`."""
 from __future__ import annotations
 
+import json
+
 from tests.cli.cli_runner import crest
 from crest.exit_codes import ExitCode
 
@@ -11,7 +13,9 @@ def test_a_sweep_on_the_rod_plant_runs_to_the_end(tmp_path):
                    str(tmp_path / "sweep.csv"))
     assert result.returncode == 0, result.stderr
     assert "RMS tip error" in result.stdout
-    assert (tmp_path / "sweep.csv").exists()
+    # the log says which plant it was measured on, and that results on it are out of family
+    plant = json.loads((tmp_path / "sweep.json").read_text())["plant"]
+    assert plant.startswith("rod family") and "with stiffness_step" in plant and "out of family" in plant
 
 
 def test_a_dahl_effect_name_on_the_rod_plant_is_refused_before_anything_moves(tmp_path):
