@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from control.benchmark import controller_cycle_times
-from crest.bench import model_bench, plant_bench, stack_bench, view_bench
+from crest.bench import model_bench, plant_bench, recording_bench, stack_bench, view_bench
 from crest.cli.common_options import check_output
 from crest.bench.machine_info import machine_info
 from crest.bench.machine_stalls import PROBE_PERIOD_S, PROBE_PRIORITY, STALL_THRESHOLD_S, machine_floor
@@ -19,12 +19,13 @@ GAP_CASES = {"synthetic": "Gap diagnosis, synthetic 10-min 100 Hz log (easy case
              "virtual_testbed": "Gap diagnosis, 10-min 100 Hz virtual-testbed log, drawn plant",
              "real": "Gap diagnosis, longest real log"}
 STACK_REALTIME_PRIORITY = 20    # SCHED_FIFO priority of the full stack's threads (crest.driver.realtime_scheduling)
-SECTIONS = ("model", "dynamic", "scaling", "move", "controllers", "rod_plant", "full_stack", "stack_profile", "gap",
-            "view")
+SECTIONS = ("model", "dynamic", "scaling", "move", "controllers", "rod_plant", "recording", "full_stack",
+            "stack_profile", "gap", "view")
 
 
 def add_parser(sub) -> None:
-    parser = sub.add_parser("bench", help="benchmark the model, controllers, rod plant, full stack and gap diagnosis")
+    parser = sub.add_parser("bench", help="benchmark the model, controllers, rod plant, recording in simulated time, "
+                                          "full stack and gap diagnosis")
     parser.add_argument("--json", dest="json_path", default="bench.json", help="where to write the results")
     parser.add_argument("--only", nargs="+", choices=SECTIONS, default=list(SECTIONS),
                         help="run only these sections")
@@ -64,6 +65,7 @@ def run(args: argparse.Namespace) -> int:
         "move": lambda: model_bench.quasi_static_move(params),
         "controllers": lambda: controller_cycle_times(params),
         "rod_plant": lambda: plant_bench.rod_plant(),
+        "recording": lambda: recording_bench.recording(),
         "full_stack": lambda: {
             "machine_floor": machine_floor_result(args.stack_seconds, args.realtime_priority),
             **{f"{rate:.0f}_hz_testbed_process": stack_bench.full_stack(
@@ -179,6 +181,11 @@ def format_table(results: dict) -> str:
                      f"{r['real_time_factor_at_100_hz']:.1f}x real time at 100 Hz "
                      f"({r['step_rate_per_cpu_s']:.0f} steps per CPU second)",
                      f">= {r['goal_step_rate_hz']:.0f} steps/s", r["step_rate_hz"] >= r["goal_step_rate_hz"]))
+    for r in results.get("recording", {}).values():
+        rows.append((f"Recording in simulated time, the short excitation (what a blind case records two or three "
+                     f"times), {r['family']} plant", f"{r['sync_cycles']} SYNC cycles ({r['simulated_s']:.0f} s simulated) in "
+                     f"{r['wall_s']:.1f} s, {r['cpu_s']:.1f} s CPU: {r['cycles_per_cpu_s']:.0f} cycles per CPU "
+                     f"second, {r['simulated_time_factor']:.1f}x real time", "-", None))
     stacks = dict(results.get("full_stack", {}))
     floor = stacks.pop("machine_floor", None)
     if floor is not None:

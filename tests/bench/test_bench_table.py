@@ -46,3 +46,12 @@ def test_the_profiled_run_shows_each_process_cpu_by_thread_and_where_each_thread
     assert "python-can" not in master and "aurora" not in master      # under 10% of samples, under 1% CPU
     refused = format_table({"stack_profile": {"unavailable": "py-spy is not installed"}})
     assert "| Full stack at 500 Hz across processes, profiled | no profile: py-spy is not installed |" in refused
+
+
+def test_the_recording_rows_name_each_plant_family_and_every_figure_measured():
+    recorded = {"family": "rod", "sync_cycles": 22923, "simulated_s": 229.23, "wall_s": 61.4, "cpu_s": 60.2,
+                "cycles_per_cpu_s": 380.8, "simulated_time_factor": 3.73}
+    table = format_table({"recording": {"rod": recorded}})
+    row = next(line for line in table.splitlines() if line.startswith("| Recording in simulated time"))
+    assert "rod plant" in row and "22923 SYNC cycles (229 s simulated) in 61.4 s, 60.2 s CPU" in row
+    assert "381 cycles per CPU second, 3.7x real time" in row
