@@ -1,7 +1,7 @@
 """Session set-up shared by every test.
 
-The numba kernels (the model's and the rod plant's) are compiled once, before pytest-xdist starts
-its workers (`pytest_configure`). The controller also makes the run's shared folder
+The numba kernels (the model's and the rod plant's, the two at once in two processes) are compiled
+once, before pytest-xdist starts its workers (`pytest_configure`). The controller also makes the run's shared folder
 ($CREST_TEST_SHARED_DIR, removed at the end), where a result that several workers need is computed
 once (tests.gap.conftest.diagnosed).
 
@@ -14,11 +14,14 @@ from __future__ import annotations
 
 import os
 import shutil
+import subprocess
+import sys
 import tempfile
 
 import pytest
 
 SHARED_DIR_VARIABLE = "CREST_TEST_SHARED_DIR"
+ROD_KERNEL_WARM_UP = "from sim_backend.plant.rod.rod_plant import RodPlant; RodPlant().step(0.01, [0.5, 0, 0, 0], 0.0)"
 
 
 def pytest_configure(config):
@@ -32,15 +35,17 @@ def pytest_configure(config):
     if hasattr(config, "workerinput") or not config.getoption("numprocesses", default=None):
         return      # an xdist worker (the controller has compiled them), or one process: it compiles as it goes
     os.environ[SHARED_DIR_VARIABLE] = tempfile.mkdtemp(prefix="crest-tests-")     # the workers inherit it
+    # the rod plant's kernel compiles in a second process meanwhile: numba compiles on one core
+    rod = subprocess.Popen([sys.executable, "-c", ROD_KERNEL_WARM_UP], cwd=config.rootpath)
     from model import CatheterParams, ConstantCurvature, DahlCatheter
-    from sim_backend.plant.rod.rod_plant import RodPlant
     params, pull_mm = CatheterParams.from_toml(), [0.5, 0.0, 0.0, 0.0]
     catheter = DahlCatheter(params, n_elements=4)
     catheter.move_to(pull_mm)
     _ = catheter.backbone_mm
     ConstantCurvature(params).tip_mm(pull_mm, 50.0)
     ConstantCurvature(params).backbone_mm(pull_mm, 50.0)
-    RodPlant().step(0.01, pull_mm, 0.0)
+    if rod.wait() != 0:
+        raise pytest.UsageError(f"compiling the rod plant's kernel failed (exit {rod.returncode}); see its traceback above")
 
 
 def pytest_unconfigure(config):
