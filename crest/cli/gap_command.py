@@ -108,10 +108,10 @@ def run(args: argparse.Namespace) -> int:
     if not args.train or not args.holdout:
         raise ValueError("give training logs and --holdout logs (recorded on other trajectories), "
                          "e.g. `crest gap train.csv --holdout test.csv`")
-    plants = {str(path): recorded_plant(path) for path in [*args.train, *args.holdout]}   # bad logs refused here
-    with open_executor(args.scheduler, args.workers) as executor:
+    with open_executor(args.scheduler, args.workers) as executor:      # an unreachable scheduler is refused first
         if args.scheduler:
             _progress(f"fits run on the Dask cluster at {args.scheduler}")
+        plants = {str(path): recorded_plant(path) for path in [*args.train, *args.holdout]}
         result = diagnose_logs(args.train, args.holdout, args.catheter, settings, progress=_progress,
                                executor=executor)
     result["log_plants"] = plants
