@@ -178,3 +178,14 @@ def motion_plan(args: argparse.Namespace) -> MotionPlan:
     params = catheter_params(args)
     return MotionPlan(config, params, workspace_for(config, params), limits_for(config), config.sync.period_s,
                       Articulation(0.0, 0.0, config.insertion_axis.home_position_mm))
+
+
+def plant_lines(plants: dict[str, str | None]) -> list[str]:
+    """Where logs came from, as their sidecars say ({log: `crest.log.recorded_plant`}): the virtual
+    testbed's plant and its family (a result on the Dahl family is in family, on the rod family out of
+    family), or that a log names none."""
+    named = sorted({plant for plant in plants.values() if plant is not None})
+    lines = [f"logs recorded on the virtual testbed, plant: {plant}" for plant in named]
+    if None in plants.values():
+        lines.append("logs with no plant in their sidecar: hardware, imported, or recorded before crest kept it")
+    return lines

@@ -9,9 +9,10 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from crest.cli.common_options import check_output, positive_number
+from crest.cli.common_options import check_output, plant_lines, positive_number
 from crest.gap.log_diagnosis import calibrate_logs, prior_catheter
 from crest.gap.log_recordings import load_recordings
+from crest.log import recorded_plant
 from model.gap.calibration import rmse_mm, tip_errors
 from model.gap.diagnosis import DiagnosisSettings
 from model.gap.recording import RecordingError
@@ -45,6 +46,7 @@ def run(args: argparse.Namespace) -> int:
     check_output(args.out)                                         # refused now, not after the fit
     check_output(args.json_path)
     held = load_recordings(args.holdout)                           # a bad file is refused before the fit
+    plants = plant_lines({str(path): recorded_plant(path) for path in args.train})
     settings = DiagnosisSettings(resolution=fit_resolution(args.fit_rate_hz))
     fit = calibrate_logs(args.train, args.catheter, settings,
                          progress=lambda message: print(f"crest fit: {message}", file=sys.stderr, flush=True),
@@ -64,6 +66,7 @@ def run(args: argparse.Namespace) -> int:
     if held:
         header.append(f"# held-out tip RMSE {holdout_rmse_mm:.3f} mm on {', '.join(str(p) for p in args.holdout)}")
     header += [f"# FLAG: {flag}" for flag in fit.flags]
+    header += [f"# {line}" for line in plants]
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text("\n".join(header) + "\n" + fitted.to_toml())
     if args.json_path:
@@ -82,6 +85,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"correlated: {a} / {b} ({c:+.2f})")
     for flag in fit.flags:
         print(f"FLAG: {flag} (the model may be bending this parameter to hide a missing effect; try `crest gap`)")
+    print("\n".join(plants))
     print(f"wrote {args.out}")
     return 0
 

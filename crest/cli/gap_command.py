@@ -14,7 +14,7 @@ import sys
 from contextlib import nullcontext
 from pathlib import Path
 
-from crest.cli.common_options import check_output
+from crest.cli.common_options import check_output, plant_lines
 from crest.gap.blind_benchmark import run_blind_benchmark
 from crest.gap.blind_combine import combined_scores
 from crest.gap.fit_executor import check_scheduler_address, dask_executor, open_executor
@@ -120,18 +120,8 @@ def run(args: argparse.Namespace) -> int:
         path = write_gap_report(result, load_recordings(args.holdout), args.report)
         print(f"report written to {path}")
     print(format_verdict(result))
-    print(plant_lines(plants))
+    print("\n".join(plant_lines(plants)))
     return 0
-
-
-def plant_lines(plants: dict[str, str | None]) -> str:
-    """Where the logs came from, as their sidecars say: the virtual testbed's plant and its family (a
-    score on the Dahl family is in family, on the rod family out of family), or none named."""
-    named = sorted({plant for plant in plants.values() if plant is not None})
-    lines = [f"logs recorded on the virtual testbed, plant: {plant}" for plant in named]
-    if None in plants.values():
-        lines.append("logs with no plant in their sidecar: hardware, imported, or recorded before crest kept it")
-    return "\n".join(lines)
 
 
 def _write_json(result: dict, path: Path | None) -> None:

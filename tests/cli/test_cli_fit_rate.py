@@ -27,6 +27,10 @@ def test_a_fit_at_50_hz_uses_every_other_row_of_a_100_hz_log(tmp_path):
     assert train["rows"] == rows and train["decimation"] == 2   # the 100 Hz SYNC's rows, every other one
     assert train["rows_used"] == (rows + 1) // 2
     assert "decimated to about 50 Hz" in (tmp_path / "fit.toml").read_text()
+    # the fitted catheter says which plant its log came from: the default Dahl plant, the model's own
+    plant = "logs recorded on the virtual testbed, plant: Dahl family"
+    assert f"# {plant}" in (tmp_path / "fit.toml").read_text() and plant in result.stdout
+    assert "in family" in result.stdout
 
 
 @pytest.mark.parametrize("rate", ["0", "-10", "nan", "fast"])
