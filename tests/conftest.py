@@ -37,13 +37,18 @@ def pytest_configure(config):
     os.environ[SHARED_DIR_VARIABLE] = tempfile.mkdtemp(prefix="crest-tests-")     # the workers inherit it
     # the rod plant's kernel compiles in a second process meanwhile: numba compiles on one core
     rod = subprocess.Popen([sys.executable, "-c", ROD_KERNEL_WARM_UP], cwd=config.rootpath)
-    from model import CatheterParams, ConstantCurvature, DahlCatheter
-    params, pull_mm = CatheterParams.from_toml(), [0.5, 0.0, 0.0, 0.0]
-    catheter = DahlCatheter(params, n_elements=4)
-    catheter.move_to(pull_mm)
-    _ = catheter.backbone_mm
-    ConstantCurvature(params).tip_mm(pull_mm, 50.0)
-    ConstantCurvature(params).backbone_mm(pull_mm, 50.0)
+    try:
+        from model import CatheterParams, ConstantCurvature, DahlCatheter
+        params, pull_mm = CatheterParams.from_toml(), [0.5, 0.0, 0.0, 0.0]
+        catheter = DahlCatheter(params, n_elements=4)
+        catheter.move_to(pull_mm)
+        _ = catheter.backbone_mm
+        ConstantCurvature(params).tip_mm(pull_mm, 50.0)
+        ConstantCurvature(params).backbone_mm(pull_mm, 50.0)
+    except BaseException:
+        rod.kill()          # the session ends here: the process it started ends with it
+        rod.wait()
+        raise
     if rod.wait() != 0:
         raise pytest.UsageError(f"compiling the rod plant's kernel failed (exit {rod.returncode}); see its traceback above")
 
