@@ -3,7 +3,8 @@
     crest gap TRAIN.csv [...] --holdout TEST.csv [...] --json OUT.json --report DIR
     crest gap --blind-benchmark --cases 40 --seed S --json OUT.json --report DIR
     crest gap --real-data [DIR] --json OUT.json: every real log held out once (crest.gap.real_data_table)
-    crest gap --combine BLIND.json [...]: stored blind results scored together (crest.gap.blind_combine)
+    crest gap --combine BLIND.json [...] --report DIR: stored blind results scored together, with their
+        report and figures (crest.gap.blind_combine)
     either with --scheduler tcp://HOST:PORT: the fits run on a Dask cluster (crest.gap.fit_executor)
 """
 from __future__ import annotations
@@ -15,8 +16,8 @@ from contextlib import nullcontext
 from pathlib import Path
 
 from crest.cli.common_options import check_output, plant_lines
-from crest.gap.blind_benchmark import run_blind_benchmark
-from crest.gap.blind_combine import combined_scores
+from crest.gap.blind_benchmark import ALL_EFFECTS, run_blind_benchmark
+from crest.gap.blind_combine import combined_result
 from crest.gap.fit_executor import check_scheduler_address, dask_executor, open_executor
 from crest.gap.log_diagnosis import diagnose_logs
 from crest.gap.log_recordings import load_recordings
@@ -72,9 +73,11 @@ def run(args: argparse.Namespace) -> int:
     if args.combine is not None:
         if args.train or args.holdout or args.blind_benchmark or args.real_data is not None:
             raise ValueError("--combine scores stored results; do not pass logs, --blind-benchmark or --real-data")
-        scores = combined_scores(args.combine)
-        _write_json({"combined": [str(path) for path in args.combine], "score": scores}, args.json_path)
-        print("\n".join(format_family_score(family, score) for family, score in scores.items()))
+        combined = combined_result(args.combine)
+        _write_json(combined, args.json_path)
+        print("\n".join(format_family_score(family, score) for family, score in combined["score"].items()))
+        if args.report:
+            print(f"report written to {write_blind_report(combined, args.report)}")
         return 0
     if args.real_data is not None:
         if args.train or args.holdout or args.blind_benchmark:
@@ -175,6 +178,15 @@ def format_score(score: dict) -> str:
         f"{shrink.get('median', float('nan')):.1f} pp, within 10 pp in {pct(shrink.get('within_10pp'))} of cases"])
 
 
+def _pooled_curve(title: str, curve: dict) -> str:
+    """One line of the detection-limit curve pooled over every effect: each bin's top-1 of its cases."""
+    parts = []
+    for row in curve.get(ALL_EFFECTS, []):
+        high = "inf" if row["ratio_high"] is None else f"{row['ratio_high']:g}"
+        parts.append(f"{row['ratio_low']:g}-{high}: {_count(row['top1'], row['cases'])}")
+    return f"{title} {'; '.join(parts) or '-'}"
+
+
 def format_family_score(family: str, score: dict) -> str:
     """The family's heading, `format_score`, and the scores the issue-14 benchmark adds (counted)."""
     counts = score["counts"]
@@ -183,9 +195,13 @@ def format_family_score(family: str, score: dict) -> str:
              " (target >= 90 %)",
              f"clean cases with no catalog effect named ('none' or 'unexplained'): "
              f"{_count(score['no_catalog_effect_clean'], counts['none'])} (target >= 80 %)"]
+    lines.append(_pooled_curve("top-1 by the effect's size / baseline residual, all effects:",
+                               score["detection_curve"]))
     if counts.get("single_with_visible_size"):
         lines.append(f"top-1 above the detection limit by the effect's visible part, what the calibrated model "
                      f"cannot absorb: {_count(score['top1_single_above_visible_limit'], counts['single_above_visible_limit'])}")
+        lines.append(_pooled_curve("top-1 by the visible part / baseline residual, all effects:",
+                                   score["visible_detection_curve"]))
     if counts.get("single_above_detection_with_candidates"):
         lines.append("the true effect ranked first among the candidates above the detection limit, the most any "
                      f"verdict rule could name: {_count(score['truth_ranked_first_above_detection'], counts['single_above_detection_with_candidates'])}")

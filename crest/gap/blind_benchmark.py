@@ -90,6 +90,7 @@ RATIO_EDGES = (0.0, 0.1, 0.2, 0.35, 0.5, 0.7, 1.0, math.inf)   # bins of the det
 TARGETS = {"top1_single_above_detection": 0.9, "no_catalog_effect_clean": 0.8, "unexplained_out_of_catalog": 0.8,
            "shrink_error_pp": 10.0}
 NO_RESULT = "no result"
+ALL_EFFECTS = "all effects"       # the detection-limit curve pooled over every effect
 # A plant whose solver fails loses the tracker's tip (the virtual tracker reports the tool missing),
 # reports absurd tensions (the testbed's safety stop ends the run) or never returns (the recording
 # exceeds its time limit). Each way the case is redrawn.
@@ -432,19 +433,25 @@ def candidate_summary(candidate: dict) -> dict:
 
 def detection_curve(rows: list[dict], size: str = "relative_size") -> dict[str, list[dict]]:
     """Top-1 per effect in bins of the effect's size relative to the baseline residual (RATIO_EDGES):
-    its raw size ("relative_size") or its visible part ("visible_relative_size")."""
-    curve: dict[str, list[dict]] = {}
-    for effect_id in sorted({r["truth"][0] for r in rows}):
-        mine = [r for r in rows if r["truth"][0] == effect_id and size in r]
-        bins = []
-        for low, high in zip(RATIO_EDGES[:-1], RATIO_EDGES[1:]):
-            inside = [r for r in mine if low <= r[size] < high]
-            if inside:
-                bins.append({"ratio_low": low, "ratio_high": high if math.isfinite(high) else None,
-                             "cases": len(inside),
-                             "top1": float(np.mean([r["predicted"] == effect_id for r in inside]))})
-        curve[effect_id] = bins
+    its raw size ("relative_size") or its visible part ("visible_relative_size"); and under ALL_EFFECTS
+    the same pooled over every effect, which shows whether any size limit reaches the top-1 target."""
+    curve = {effect_id: _top1_bins([r for r in rows if r["truth"][0] == effect_id], size)
+             for effect_id in sorted({r["truth"][0] for r in rows})}
+    if curve:
+        curve[ALL_EFFECTS] = _top1_bins(rows, size)
     return curve
+
+
+def _top1_bins(rows: list[dict], size: str) -> list[dict]:
+    """The share of `rows` whose verdict names their true effect, per bin of `size` (RATIO_EDGES)."""
+    bins = []
+    for low, high in zip(RATIO_EDGES[:-1], RATIO_EDGES[1:]):
+        inside = [r for r in rows if size in r and low <= r[size] < high]
+        if inside:
+            bins.append({"ratio_low": low, "ratio_high": high if math.isfinite(high) else None,
+                         "cases": len(inside),
+                         "top1": float(np.mean([r["predicted"] == r["truth"][0] for r in inside]))})
+    return bins
 
 
 def score(all_rows: list[dict]) -> dict:

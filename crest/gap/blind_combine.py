@@ -34,13 +34,16 @@ def load_cases(path: Path) -> list[dict]:
     return cases
 
 
-def combined_scores(paths: Sequence[Path]) -> dict[str, dict]:
-    """{family: score of the union of its cases over every file}, families in first-seen order.
-    Every file is read before anything is scored, so a bad one fails the whole call."""
+def combined_result(paths: Sequence[Path]) -> dict:
+    """{"combined": the files, "score": {family: score of the union of its cases over every file}
+    (families in first-seen order), "cases": every case row}: the shape of a blind-benchmark result,
+    so that its report can be written as one run's is. Every file is read before anything is scored,
+    so a bad one fails the whole call."""
     if not paths:
         raise BlindResultError("give at least one stored blind-benchmark result (blind.json)")
+    rows = [row for path in paths for row in load_cases(path)]
     by_family: dict[str, list[dict]] = {}
-    for path in paths:
-        for row in load_cases(path):
-            by_family.setdefault(row["family"], []).append(row)
-    return {family: score(rows) for family, rows in by_family.items()}
+    for row in rows:
+        by_family.setdefault(row["family"], []).append(row)
+    return {"combined": [str(path) for path in paths],
+            "score": {family: score(family_rows) for family, family_rows in by_family.items()}, "cases": rows}

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
+from crest.gap.blind_benchmark import ALL_EFFECTS
 from crest.paper.figure_output import new_figure, save_png
 
 
@@ -55,10 +56,15 @@ def _pct(value: float | None) -> str:
 
 
 def markdown(result: dict) -> str:
-    settings = result["settings"]
-    lines = ["# Blind benchmark of the gap diagnosis", "",
-             f"Seed {settings['seed']}, {settings['excitation']} excitation, {settings['path']}; "
-             f"{settings['seconds'] / 60:.0f} min.", ""]
+    """One run's report (its seed and settings), or that of stored runs scored together (`combined`:
+    their files)."""
+    if "combined" in result:
+        source = f"Stored results scored together (`crest gap --combine`): {', '.join(result['combined'])}."
+    else:
+        settings = result["settings"]
+        source = (f"Seed {settings['seed']}, {settings['excitation']} excitation, {settings['path']}; "
+                  f"{settings['seconds'] / 60:.0f} min.")
+    lines = ["# Blind benchmark of the gap diagnosis", "", source, ""]
     for family, score in result["score"].items():
         lines += _family_markdown(family, score)
     lines += ["## Cases", "",
@@ -145,7 +151,8 @@ def _detection_figure(curve: dict, visible_curve: dict | None = None) -> Figure:
             if bins:
                 centres = [(row["ratio_low"] + (row["ratio_high"] if row["ratio_high"] is not None
                                                 else 1.5 * max(row["ratio_low"], 1.0))) / 2 for row in bins]
-                ax.plot(centres, [row["top1"] for row in bins], marker="o", label=effect_id)
+                pooled = {"color": "black", "linewidth": 2.5} if effect_id == ALL_EFFECTS else {}
+                ax.plot(centres, [row["top1"] for row in bins], marker="o", label=effect_id, **pooled)
         ax.set_xlabel(label)
         ax.set_ylabel("top-1")
         ax.set_ylim(-0.05, 1.05)

@@ -1,7 +1,7 @@
 """Blind benchmark bookkeeping (issue 6, blind validation): the draw and the scores."""
 import pytest
 
-from crest.gap.blind_benchmark import draw_cases, score
+from crest.gap.blind_benchmark import ALL_EFFECTS, draw_cases, score
 from model import CatheterParams
 from model.effects import EFFECTS
 
@@ -60,12 +60,18 @@ def test_clean_cases_count_none_and_unexplained_as_right_and_out_of_catalog_case
 def test_detection_curve_bins_top1_by_effect_size_relative_to_the_baseline_residual():
     rows = [{**row("single", ["backlash"], "backlash"), "relative_size": 0.8, "above_detection_limit": True},
             {**row("single", ["backlash"], "none"), "relative_size": 0.05, "above_detection_limit": False},
-            {**row("single", ["backlash"], "backlash"), "relative_size": 0.06, "above_detection_limit": False}]
+            {**row("single", ["backlash"], "backlash"), "relative_size": 0.06, "above_detection_limit": False},
+            {**row("single", ["gravity"], "none"), "relative_size": 3.0, "above_detection_limit": True}]
     result = score(rows)
     assert result["detection_curve"]["backlash"] == [
         {"ratio_low": 0.0, "ratio_high": 0.1, "cases": 2, "top1": 0.5},
         {"ratio_low": 0.7, "ratio_high": 1.0, "cases": 1, "top1": 1.0}]
-    assert result["top1_single_above_detection"] == 1.0 and result["counts"]["single_above_detection"] == 1
+    # pooled over every effect: a large gravity missed is counted in the open top bin
+    assert result["detection_curve"][ALL_EFFECTS] == [
+        {"ratio_low": 0.0, "ratio_high": 0.1, "cases": 2, "top1": 0.5},
+        {"ratio_low": 0.7, "ratio_high": 1.0, "cases": 1, "top1": 1.0},
+        {"ratio_low": 1.0, "ratio_high": None, "cases": 1, "top1": 0.0}]
+    assert result["top1_single_above_detection"] == 0.5 and result["counts"]["single_above_detection"] == 2
 
 
 def test_rod_draw_holds_clean_single_and_out_of_catalog_cases_in_the_rods_own_terms(tmp_path):
