@@ -12,6 +12,7 @@ from crest.cli.compile_notice import announce_compiles
 from crest.cli.debug_option import add_debug_option
 from crest.cli.library_logging import route_library_logging
 from crest.cli.stop_signals import install_stop_signals
+from crest.cli.warning_lines import route_warnings
 from crest.config import ConfigError
 from crest.driver import SafetyStop, Terminated
 from crest.exit_codes import ExitCode
@@ -47,6 +48,7 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     args = build_parser(command_names(argv)).parse_args(argv)
     route_library_logging(args.debug)
+    route_warnings(args.debug)
     announce_compiles()
     try:
         return int(args.handler(args))
