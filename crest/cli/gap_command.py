@@ -1,6 +1,6 @@
 """`crest gap`: diagnose the sim-to-real gap of logs, or validate the diagnosis blind.
 
-    crest gap TRAIN.csv [...] --holdout TEST.csv [...] --json OUT.json --report DIR
+    crest gap TRAIN.csv [...] --holdout TEST.csv [...] --json OUT.json --report DIR [--effects ID,...]
     crest gap --blind-benchmark --cases 40 --seed S --json OUT.json --report DIR
     crest gap --real-data [DIR] --json OUT.json: every real log held out once (crest.gap.real_data_table)
     crest gap --combine BLIND.json [...] --report DIR: stored blind results scored together, with their
@@ -24,7 +24,8 @@ from crest.gap.log_recordings import load_recordings
 from crest.gap.real_data_table import real_data_table, table_markdown
 from crest.log import recorded_plant
 from crest.reports.blind_report import write_blind_report
-from crest.reports.gap_report import sampling_lines, write_gap_report
+from crest.reports.gap_report import candidate_set_lines, sampling_lines, write_gap_report
+from model.effects import EFFECTS
 from model.gap.diagnosis import DiagnosisSettings
 from model.gap.finite_json import finite_tree
 
@@ -37,6 +38,9 @@ def add_parser(sub) -> None:
     parser.add_argument("--report", type=Path, default=None, help="write the report (Markdown) and PNG figures here")
     parser.add_argument("--catheter", default=None, help="starting catheter TOML (default configs/catheter.toml)")
     parser.add_argument("--workers", type=int, default=2, help="parallel candidate fits (default 2)")
+    parser.add_argument("--effects", type=effect_ids, default=tuple(EFFECTS), metavar="ID[,ID...]",
+                        help="fit only these candidate effects (default: the whole catalog: "
+                             f"{', '.join(EFFECTS)}); the verdict is among them")
     parser.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
                         help="run the fits on the Dask cluster whose scheduler listens here, instead of on "
                              "--workers local processes; the result is the same")
@@ -59,6 +63,16 @@ def add_parser(sub) -> None:
     parser.set_defaults(handler=run)
 
 
+def effect_ids(text: str) -> tuple[str, ...]:
+    """argparse type: comma-separated ids of the catalog's effects, each once, in the order given."""
+    ids = tuple(dict.fromkeys(part.strip() for part in text.split(",") if part.strip()))
+    unknown = [effect_id for effect_id in ids if effect_id not in EFFECTS]
+    if unknown or not ids:
+        cause = f"unknown effect {unknown[0]!r}" if unknown else "no effect given"
+        raise argparse.ArgumentTypeError(f"{cause}; the catalog's effects: {', '.join(EFFECTS)}")
+    return ids
+
+
 def _progress(message: str) -> None:
     print(f"crest gap: {message}", file=sys.stderr, flush=True)
 
@@ -69,7 +83,11 @@ def run(args: argparse.Namespace) -> int:
     check_output(args.work_dir, directory=True)
     if args.scheduler is not None:
         check_scheduler_address(args.scheduler)
-    settings = DiagnosisSettings(workers=args.workers)
+    settings = DiagnosisSettings(workers=args.workers, effects=args.effects)
+    if args.effects != tuple(EFFECTS) and (args.blind_benchmark or args.combine is not None
+                                           or args.real_data is not None):
+        raise ValueError("--effects applies to a diagnosis of given logs: --blind-benchmark, --real-data and "
+                         "--combine score the whole catalog")
     if args.combine is not None:
         if args.train or args.holdout or args.blind_benchmark or args.real_data is not None:
             raise ValueError("--combine scores stored results; do not pass logs, --blind-benchmark or --real-data")
@@ -148,6 +166,7 @@ def format_verdict(result: dict) -> str:
              "gap concentrates in: " + (", ".join(result["concentrated"][:5]) or "no region"),
              f"verdict: {verdict['effect']}" + (f" ({' + '.join(verdict['effects'])})" if len(verdict["effects"]) > 1
                                                 else ""),
+             *candidate_set_lines(result["settings"]),
              f"held-out (report half) {verdict['holdout_rmse_before_mm']:.3f} -> "
              f"{verdict['holdout_rmse_after_mm']:.3f} mm, shrink {100 * verdict['shrink']:.1f} % "
              f"(selected on the other half: {verdict['shrink_estimate']['method']})"]

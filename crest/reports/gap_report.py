@@ -15,6 +15,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from crest.paper.figure_output import new_figure, save_png
+from model.effects import EFFECTS
 from model.gap.calibration import ModelFit
 from model.gap.recording import Recording
 from model.gap.simulation import Resolution, predict_tips
@@ -107,6 +108,7 @@ def markdown(result: dict) -> str:
              "## Verdict", "",
              f"- effect: **{verdict['effect']}**" + (f" (selected: {', '.join(verdict['effects'])})"
                                                     if len(verdict["effects"]) > 1 else ""),
+             *[f"- {line}" for line in candidate_set_lines(result["settings"])],
              f"- held-out tip RMSE {verdict['holdout_rmse_before_mm']:.3f} mm -> "
              f"{verdict['holdout_rmse_after_mm']:.3f} mm, shrink {100 * verdict['shrink']:.1f} % on the report half "
              f"({verdict['shrink_estimate']['method']}; on the selection half {100 * verdict['selection_shrink']:.1f} %)",
@@ -168,6 +170,16 @@ def markdown(result: dict) -> str:
               "Strong correlations: " + ("; ".join(f"{c['a']} / {c['b']}: {c['correlation']:+.2f}"
                                                    for c in fit["strong_correlations"]) or "none"), ""]
     return "\n".join(lines)
+
+
+def candidate_set_lines(settings: dict) -> list[str]:
+    """One line when the diagnosis fitted only some of the catalog's effects (`crest gap --effects`): the
+    verdict is then among those alone. No line for the whole catalog."""
+    fitted = settings["effects"]
+    if set(fitted) == set(EFFECTS):
+        return []
+    return [f"candidates: only {', '.join(fitted)} ({len(fitted)} of the catalog's {len(EFFECTS)} effects, "
+            "--effects): the verdict is among them"]
 
 
 def sampling_lines(sampling: dict) -> list[str]:

@@ -170,3 +170,22 @@ def test_fault_and_effect_help_list_every_kind_axis_and_effect_id():
     for effect_id, effect in EFFECTS.items():
         assert f"{effect_id} ({', '.join(effect.param_names)})" in text
     assert "SECONDS counts from the start of the command's motion" in text
+
+
+@pytest.mark.parametrize("effects,says", [("backlash,friction", "unknown effect 'friction'"), (",", "no effect given")])
+def test_gap_refuses_an_effect_the_catalog_does_not_hold_before_reading_a_log(tmp_path, effects, says):
+    result = crest("gap", str(tmp_path / "missing.csv"), "--holdout", str(tmp_path / "missing.csv"),
+                   "--effects", effects)
+    assert result.returncode == ExitCode.USAGE, result.stderr
+    assert f"--effects: {says}; the catalog's effects: tendon_elasticity, backlash," in result.stderr
+    assert "no such file" not in result.stderr and "Traceback" not in result.stderr
+
+
+@pytest.mark.parametrize("mode", [["--blind-benchmark", "--cases", "1"], ["--real-data"]])
+def test_the_whole_catalogs_scores_refuse_effects_before_any_work(tmp_path, mode):
+    result = crest("gap", *mode, "--effects", "backlash", "--work-dir", str(tmp_path / "w"))
+    assert result.returncode == ExitCode.ERROR, result.stderr
+    assert result.stderr.strip() == ("crest: error: --effects applies to a diagnosis of given logs: --blind-benchmark, "
+                                     "--real-data and --combine score the whole catalog (run with --debug for the "
+                                     "traceback)")
+    assert not (tmp_path / "w").exists()

@@ -1,5 +1,5 @@
 """The gap diagnosis on a Dask cluster (issue 17, item 4): the fits run on a LocalCluster on 127.0.0.1 and
-give the same diagnosis as local processes; `crest gap --scheduler` works end to end, refuses an address
+give the same diagnosis as local processes; `crest gap --scheduler` works end to end (with `--effects`), refuses an address
 where no scheduler answers before any work, and Ctrl-C during a cluster-run blind benchmark stops it with
 one line and leaves no task on the cluster. Every cluster is started and stopped here."""
 import dataclasses
@@ -71,13 +71,18 @@ def test_the_cluster_gives_the_local_diagnosis(cluster, tmp_path, effects):
 def test_crest_gap_runs_its_fits_on_the_scheduler(cluster, tmp_path):
     address, client = cluster
     train, holdout = record_case(tmp_path, {"backlash": None}, seed=3)
-    run = crest("gap", str(train), "--holdout", str(holdout), "--scheduler", address,
-                "--json", str(tmp_path / "gap.json"), timeout_s=1800.0)
+    run = crest("gap", str(train), "--holdout", str(holdout), "--scheduler", address, "--effects",
+                ",".join(SETTINGS.effects), "--json", str(tmp_path / "gap.json"), "--report", str(tmp_path / "report"),
+                timeout_s=1800.0)
     assert run.returncode == 0, run.stderr
     assert f"fits run on the Dask cluster at {address}" in run.stderr
     assert "verdict: backlash" in run.stdout
+    # only the effects asked for were fitted, and the output and the report say the verdict is among them
+    said = "candidates: only backlash, tracker_offset, gravity (3 of the catalog's 11 effects, --effects)"
+    assert said in run.stdout and said in (tmp_path / "report" / "report.md").read_text()
     result = json.loads((tmp_path / "gap.json").read_text())
     assert result["verdict"]["effect"] == "backlash"
+    assert {c["effect"] for c in result["candidates"]} == set(SETTINGS.effects)
     # the logs come from a model plant written straight to files: no virtual testbed's plant in their sidecars
     assert result["log_plants"] == {str(train): None, str(holdout): None}
     assert "logs with no plant in their sidecar" in run.stdout
