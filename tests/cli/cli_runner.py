@@ -27,6 +27,17 @@ def crest(*args: str, timeout_s: float = 240.0, cwd: Path | None = None,
                           cwd=cwd or REPO, env=env)
 
 
+def record_short_run(folder: Path) -> Path:
+    """A 3 s run of two set-points (one tendon pair pulled 1 mm), recorded by `crest run --fast` into
+    folder/run.csv; returns the log's path."""
+    setpoints, log = folder / "setpoints.csv", folder / "run.csv"
+    setpoints.write_text("t,tendon_cmd_1,tendon_cmd_2,tendon_cmd_3,tendon_cmd_4,insertion_cmd\n"
+                         "0,0,0,0,0,22\n3,1.0,0,-1.0,0,22\n")
+    recorded = crest("run", str(setpoints), "--fast", "--record", str(log))
+    assert recorded.returncode == 0, recorded.stderr
+    return log
+
+
 def start_crest(*args: str, cwd: Path | None = None, env: dict[str, str] | None = None,
                 **kwargs) -> subprocess.Popen:
     env = dict(os.environ, PYTHONUNBUFFERED="1", **(env or {}))

@@ -4,18 +4,12 @@ import json
 
 import pytest
 
-from cli_runner import crest
+from cli_runner import crest, record_short_run
 from crest.exit_codes import ExitCode
 from crest.log import read_log
 
-SETPOINTS = "t,tendon_cmd_1,tendon_cmd_2,tendon_cmd_3,tendon_cmd_4,insertion_cmd\n0,0,0,0,0,22\n3,1.0,0,-1.0,0,22\n"
-
-
 def test_a_fit_at_50_hz_uses_every_other_row_of_a_100_hz_log(tmp_path):
-    setpoints, log = tmp_path / "setpoints.csv", tmp_path / "run.csv"
-    setpoints.write_text(SETPOINTS)
-    recorded = crest("run", str(setpoints), "--fast", "--record", str(log))
-    assert recorded.returncode == 0, recorded.stderr
+    log = record_short_run(tmp_path)
     rows = len(read_log(log))
     result = crest("fit", str(log), "--dynamics", "off", "--fit-rate-hz", "50", "--out", str(tmp_path / "fit.toml"),
                    "--json", str(tmp_path / "fit.json"))

@@ -1,16 +1,11 @@
 """A warning reaches the operator as one line, `crest: warning: MESSAGE`, without Python's file, category
 and source line; --debug keeps Python's own format."""
-from cli_runner import crest
-
-SETPOINTS = "t,tendon_cmd_1,tendon_cmd_2,tendon_cmd_3,tendon_cmd_4,insertion_cmd\n0,0,0,0,0,22\n3,1.0,0,-1.0,0,22\n"
+from cli_runner import crest, record_short_run
 
 
 def killed_writers_log(tmp_path):
     """A recorded log whose last line stops mid-row, as a writer killed mid-write leaves it."""
-    setpoints, log = tmp_path / "setpoints.csv", tmp_path / "run.csv"
-    setpoints.write_text(SETPOINTS)
-    recorded = crest("run", str(setpoints), "--fast", "--record", str(log))
-    assert recorded.returncode == 0, recorded.stderr
+    log = record_short_run(tmp_path)
     text = log.read_text()
     log.write_text(text[:text.rindex("\n", 0, len(text) - 1) + 8])     # the last row cut after 7 characters
     return log, len(text[:-1].splitlines())
