@@ -160,7 +160,8 @@ def _write_json(result: dict, path: Path | None) -> None:
 def format_verdict(result: dict) -> str:
     verdict = result["verdict"]
     cc = result["constant_curvature"]
-    lines = [f"baseline: train {result['baseline']['train_rmse_mm']:.3f} mm, held-out "
+    lines = [f"note: {line}" for line in result["coverage"]] + [
+             f"baseline: train {result['baseline']['train_rmse_mm']:.3f} mm, held-out "
              f"{result['baseline']['holdout_rmse_mm']:.3f} mm RMS (calibrated constant curvature: train "
              f"{cc['train_rmse_mm']:.3f} mm, held-out {cc['holdout_rmse_mm']:.3f} mm)",
              "gap concentrates in: " + (", ".join(result["concentrated"][:5]) or "no region"),

@@ -104,7 +104,8 @@ def markdown(result: dict) -> str:
     lines = ["# Sim-to-real gap report", "",
              f"Training: {', '.join(result['settings']['train'])}  ",
              f"Held out: {', '.join(result['settings']['holdout'])}", "",
-             "Sampling:", ""] + [f"- {line}" for line in sampling_lines(result["sampling"])] + ["",
+             "Sampling:", ""] + [f"- {line}" for line in sampling_lines(result["sampling"])] + [
+             f"- **{line}**" for line in result["coverage"]] + ["",
              "## Verdict", "",
              f"- effect: **{verdict['effect']}**" + (f" (selected: {', '.join(verdict['effects'])})"
                                                     if len(verdict["effects"]) > 1 else ""),

@@ -43,6 +43,7 @@ from model.gap.noise import tracker_noise_mm
 from model.gap.plausibility import hold_drift_reasons, range_reasons, signature_concentration, signature_reasons
 from model.gap.recording import Recording, RecordingError
 from model.gap.regions import breakdown, concentrated, regions, shrink_by_region
+from model.gap.coverage import coverage_lines
 from model.gap.sample_features import SampleFeatures, compute_features
 from model.gap.significance import is_meaningful, is_significant_residual, model_form_rms_mm, nothing_to_explain
 from model.gap.signatures import describe, signatures
@@ -82,7 +83,8 @@ def diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: Ca
     this one included, see `model.gap.fit_pool`).
 
     Returns {"format", "baseline", "constant_curvature", "holdout_by_recording", "where", "concentrated",
-    "signatures", "candidates", "pairs", "verdict", "settings", "sampling", "timing_s"}; "constant_curvature"
+    "signatures", "candidates", "pairs", "verdict", "coverage", "settings", "sampling", "timing_s"};
+    "coverage" lists where the held-out samples leave the training's range (`coverage_lines`); "constant_curvature"
     is the calibrated constant-curvature reference (`cc_calibration`) on the same rows, and
     "holdout_by_recording" the held-out tip RMSE of each held-out recording (all its evaluated rows) for
     constant curvature, the baseline and the baseline with the verdict's effects; "verdict" holds
@@ -288,6 +290,7 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
                        for r in singles],
         "pairs": [r.as_dict() for r in pairs],
         "verdict": verdict,
+        "coverage": coverage_lines(res.prepare_training(train), held, zeros),
         "settings": {**asdict(settings), "train": [r.name for r in train], "holdout": [r.name for r in holdout],
                      "geometry": {"tendon_offset_mm": baseline.params.tendon_offset_mm,
                                   "flexible_length_mm": train[0].flexible_length_mm}},

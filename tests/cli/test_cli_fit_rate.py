@@ -8,6 +8,7 @@ from cli_runner import crest, record_short_run
 from crest.exit_codes import ExitCode
 from crest.log import read_log
 
+
 def test_a_fit_at_50_hz_uses_every_other_row_of_a_100_hz_log(tmp_path):
     log = record_short_run(tmp_path)
     rows = len(read_log(log))
