@@ -35,6 +35,7 @@ from model.gap.calibration import ModelFit, calibrate_base, rmse_mm, tip_errors
 from model.gap.cc_calibration import calibrate_constant_curvature
 from model.gap.candidates import (CANDIDATE_ITERATIONS, CONTINUE, EXPLORE, PROBE, CandidateResult, FitTask,
                                   evaluate, ranked, run_tasks)
+from model.gap.coverage import coverage_lines
 from model.gap.finite_json import finite_tree
 from model.gap.fit_pool import fit_pool, one_blas_thread
 from model.gap.free_parameters import base_values
@@ -43,7 +44,6 @@ from model.gap.noise import tracker_noise_mm
 from model.gap.plausibility import hold_drift_reasons, range_reasons, signature_concentration, signature_reasons
 from model.gap.recording import Recording, RecordingError
 from model.gap.regions import breakdown, concentrated, regions, shrink_by_region
-from model.gap.coverage import coverage_lines
 from model.gap.sample_features import SampleFeatures, compute_features
 from model.gap.significance import is_meaningful, is_significant_residual, model_form_rms_mm, nothing_to_explain
 from model.gap.signatures import describe, signatures
@@ -116,7 +116,8 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
     base_errors = _holdout_errors(baseline, held, res)
     split = split_holdout([len(e) for e in base_errors])
     noise = tracker_noise_mm(list(train) + list(holdout))
-    reference = calibrate_constant_curvature(res.prepare_training(train), prior)   # what Dahl must beat
+    fit_rows = res.prepare_training(train)          # the training rows the fits see
+    reference = calibrate_constant_curvature(fit_rows, prior)   # what Dahl must beat
     reference_errors = reference.tip_errors(held)
     timing["baseline"] = time.perf_counter() - clock
 
@@ -290,7 +291,7 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
                        for r in singles],
         "pairs": [r.as_dict() for r in pairs],
         "verdict": verdict,
-        "coverage": coverage_lines(res.prepare_training(train), held, zeros),
+        "coverage": coverage_lines(fit_rows, held, zeros),
         "settings": {**asdict(settings), "train": [r.name for r in train], "holdout": [r.name for r in holdout],
                      "geometry": {"tendon_offset_mm": baseline.params.tendon_offset_mm,
                                   "flexible_length_mm": train[0].flexible_length_mm}},
