@@ -171,6 +171,8 @@ def format_verdict(result: dict) -> str:
              f"held-out (report half) {verdict['holdout_rmse_before_mm']:.3f} -> "
              f"{verdict['holdout_rmse_after_mm']:.3f} mm, shrink {100 * verdict['shrink']:.1f} % "
              f"(selected on the other half: {verdict['shrink_estimate']['method']})"]
+    if verdict["confidence_line"]:
+        lines.append(verdict["confidence_line"])
     if verdict["model_form_rms_mm"] is not None and not verdict["effects"]:
         lines.append(f"residual above the noise floor (model form): {verdict['model_form_rms_mm']:.3f} mm RMS")
     for row in verdict["rejected"]:
@@ -232,7 +234,12 @@ def format_family_score(family: str, score: dict) -> str:
     if counts["out_of_catalog"]:
         lines.append(f"out-of-catalog cases 'unexplained': "
                      f"{_count(score['unexplained_out_of_catalog'], counts['out_of_catalog'])} (target >= 80 %); "
-                     f"a catalog effect named in {score['catalog_effect_out_of_catalog']}")
+                     f"a catalog effect named in {score['catalog_effect_out_of_catalog']}, confidently in "
+                     f"{score['confident_catalog_effect_out_of_catalog']} (target: never)")
+    confident = score["confident_single_above_detection"]
+    lines.append(f"confident verdicts (the named effect at least halves the report half's error above the noise floor): above the detection "
+                 f"limit {confident['right']} right and {confident['wrong']} wrong; on clean cases "
+                 f"{score['confident_catalog_effect_clean']}")
     return "\n".join(lines)
 
 

@@ -21,7 +21,10 @@ tracker noise floor and by at least DETECTION_RATIO of the baseline residual); t
 curve, top-1 per effect against the effect's size relative to the baseline residual
 (effect RMS / held-out baseline RMSE); on clean cases the share with no catalog effect named
 (`none` and `unexplained` both right); on out-of-catalog cases the share `unexplained` and the
-number with a catalog effect named; how often the true effect is the best-ranked candidate above
+number with a catalog effect named, and how many of those the verdict grades `confident`
+(`model.gap.verdict_confidence`: the named effect at least halves the report half's error above
+the noise floor; the
+same count on clean cases, and confident right and wrong verdicts above the detection limit); how often the true effect is the best-ranked candidate above
 the detection limit (the verdict names a candidate or nothing, so this bounds the top-1 that any
 verdict rule could reach on these fits); the largest share of the error any candidate removed on
 clean and on out-of-catalog cases (what catalog effects can take up where the catalog holds
@@ -79,6 +82,7 @@ from model.gap.diagnosis import UNEXPLAINED, DiagnosisSettings
 from model.gap.holdout_split import split_holdout
 from model.gap.simulation import catheter_for
 from model.gap.starting_points import start_values
+from model.gap.verdict_confidence import CONFIDENT, confidence
 
 FAMILIES = ("dahl", "rod")
 CLEAN_FRACTION = 0.2
@@ -379,6 +383,7 @@ def run_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Excitat
            "holdout_rmse_after_mm": verdict["holdout_rmse_after_mm"], "noise_floor_mm": floor,
            "baseline_holdout_rmse_mm": result["baseline"]["holdout_rmse_mm"],
            "model_form_rms_mm": verdict["model_form_rms_mm"], "predicted_shrink": verdict["shrink"],
+           "predicted_confidence": verdict["confidence"],
            "top_candidates": [c["effect"] for c in result["candidates"][:3]],
            "candidates": [candidate_summary(c) for c in result["candidates"]],
            "record_seconds": recorded - start, "seconds": seconds, "timing_s": result["timing_s"],
@@ -499,6 +504,11 @@ def score(all_rows: list[dict]) -> dict:
         "unexplained_out_of_catalog": fraction([r["predicted"] == UNEXPLAINED for r in outside]),
         "catalog_effect_out_of_catalog": sum(r["predicted"] not in ("none", UNEXPLAINED, NO_RESULT)
                                              for r in outside),
+        "confident_catalog_effect_out_of_catalog": sum(_graded(r) == CONFIDENT for r in outside),
+        "confident_catalog_effect_clean": sum(_graded(r) == CONFIDENT for r in clean),
+        "confident_single_above_detection": {
+            "right": sum(_graded(r) == CONFIDENT and r["predicted"] == r["truth"][0] for r in detectable),
+            "wrong": sum(_graded(r) == CONFIDENT and r["predicted"] != r["truth"][0] for r in detectable)},
         "pair_exact": fraction([sorted(r["predicted_effects"]) == sorted(r["truth"]) for r in pairs]),
         "pair_any_found": fraction([bool(set(r["predicted_effects"]) & set(r["truth"])) for r in pairs]),
         "shrink_error_pp": {"mean": float(np.mean(errors)), "median": float(np.median(errors)),
@@ -514,6 +524,17 @@ def score(all_rows: list[dict]) -> dict:
                    "skipped": len(all_rows) - len(rows), "no_result": sum("no_result" in r for r in rows)},
         "targets": TARGETS,
     }
+
+
+def _graded(row: dict) -> str | None:
+    """The verdict's confidence grade (`model.gap.verdict_confidence`); results stored before the grade
+    existed (2026-12-06) get it from their stored report-half errors and noise floor, by the same rule."""
+    if "predicted_confidence" in row:
+        return row["predicted_confidence"]
+    if not row["predicted_effects"]:
+        return None
+    return confidence(row["predicted_effects"], row["holdout_rmse_before_mm"], row["holdout_rmse_after_mm"],
+                      row["noise_floor_mm"])
 
 
 def _largest_shrink(rows: list[dict]) -> float | None:

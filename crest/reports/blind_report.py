@@ -106,11 +106,17 @@ def _family_markdown(family: str, score: dict) -> list[str]:
         f"{_pct(score['top1_single_above_noise'])} of {counts['single'] - counts['single_below_noise']} | - |",
         f"| clean cases with no catalog effect (`none` or `unexplained`) | {_pct(score['no_catalog_effect_clean'])} "
         f"of {counts['none']} | >= 80% |",
-        f"| `none` on clean cases | {_pct(score['none_clean'])} of {counts['none']} | - |"]
+        f"| `none` on clean cases | {_pct(score['none_clean'])} of {counts['none']} | - |",
+        f"| `confident` verdicts above the detection limit: right / wrong | "
+        f"{score['confident_single_above_detection']['right']} / {score['confident_single_above_detection']['wrong']} "
+        f"| - / 0 |",
+        f"| clean cases with a catalog effect named `confident` | {score['confident_catalog_effect_clean']} | 0 |"]
     if counts["out_of_catalog"]:
         lines += [f"| `unexplained` on out-of-catalog cases | {_pct(score['unexplained_out_of_catalog'])} of "
                   f"{counts['out_of_catalog']} | >= 80% |",
-                  f"| out-of-catalog cases with a catalog effect named | {score['catalog_effect_out_of_catalog']} | 0 |"]
+                  f"| out-of-catalog cases with a catalog effect named | {score['catalog_effect_out_of_catalog']} | 0 |",
+                  f"| out-of-catalog cases with a catalog effect named `confident` (it at least halves the report "
+                  f"half's error above the noise floor) | {score['confident_catalog_effect_out_of_catalog']} | 0 |"]
     if counts["pair"]:
         lines.append(f"| pairs: exact / at least one found | {_pct(score['pair_exact'])} / "
                      f"{_pct(score['pair_any_found'])} of {counts['pair']} | - |")

@@ -113,6 +113,7 @@ def markdown(result: dict) -> str:
              f"- held-out tip RMSE {verdict['holdout_rmse_before_mm']:.3f} mm -> "
              f"{verdict['holdout_rmse_after_mm']:.3f} mm, shrink {100 * verdict['shrink']:.1f} % on the report half "
              f"({verdict['shrink_estimate']['method']}; on the selection half {100 * verdict['selection_shrink']:.1f} %)",
+             *([f"- {verdict['confidence_line']}"] if verdict['confidence_line'] else []),
              f"- training RMSE of the baseline {base['train_rmse_mm']:.3f} mm; tracker noise floor "
              + (f"{floor:.3f} mm" if floor is not None else "unknown (no static holds in the logs)")]
     for effect_id, params in verdict["params"].items():

@@ -15,8 +15,9 @@
    effect is added by greedy forward selection among the next best candidates found on their
    own, again only if the pair is meaningful against the control: the chosen effect refitted
    alone with the same budget.
-4. How far: held-out RMSE before and after, shrink overall and per region, and how the base
-   parameters moved when the effect was added.
+4. How far: held-out RMSE before and after, shrink overall and per region, how the base
+   parameters moved when the effect was added, and whether the verdict is most of the gap
+   (`verdict_confidence`: confident or partial).
 The result is a plain, JSON-able dict (see `diagnose`).
 """
 from __future__ import annotations
@@ -50,6 +51,7 @@ from model.gap.signatures import describe, signatures
 from model.gap.simplest_effect import parameter_count, simplest_sufficient
 from model.gap.simulation import Resolution, predict_tips, predict_tips_and_tension
 from model.gap.starting_points import start_values
+from model.gap.verdict_confidence import confidence, confidence_line
 from model.params import CatheterParams
 
 FORMAT = "crest-gap/2"
@@ -89,7 +91,9 @@ def diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: Ca
     "holdout_by_recording" the held-out tip RMSE of each held-out recording (all its evaluated rows) for
     constant curvature, the baseline and the baseline with the verdict's effects; "verdict" holds
     "effect" (best id or "none"), "effects" (all selected), "holdout_rmse_before_mm",
-    "holdout_rmse_after_mm" and "shrink" (0..1); "sampling" says which rows of the logs the fits and
+    "holdout_rmse_after_mm", "shrink" (0..1) and "confidence" (`verdict_confidence`: "confident" where the
+    named effects at least halve the report half's error above the noise floor, "partial" below, None
+    when nothing is named) with its "confidence_line"; "sampling" says which rows of the logs the fits and
     the held-out evaluation used (`Resolution.sampling`: decimation, the training cap).
     """
     if not train or not holdout:
@@ -249,12 +253,16 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
     after_where = breakdown(found, after_stack)
     unexplained = not final and is_significant_residual(base_rmse, noise)
     drift = base_drift(prior, after_fit.params)
+    named, after_report_rmse = list(final.effects) if final else [], final.report_rmse_mm if final else base_report_rmse
+    floor = None if noise is None else float(np.sqrt(3) * noise)
     verdict = {
         "effect": chosen[0].effects[0] if chosen else UNEXPLAINED if unexplained else "none",
-        "effects": list(final.effects) if final else [],
+        "effects": named,
         "holdout_rmse_before_mm": base_report_rmse,
-        "holdout_rmse_after_mm": final.report_rmse_mm if final else base_report_rmse,
+        "holdout_rmse_after_mm": after_report_rmse,
         "shrink": final.report_shrink if final else 0.0,
+        "confidence": confidence(named, base_report_rmse, after_report_rmse, floor),
+        "confidence_line": confidence_line(named, base_report_rmse, after_report_rmse, floor),
         "selection_shrink": final.shrink if final else 0.0,
         "shrink_estimate": split.as_dict(),
         "params": final.fit.effect_params() if final else {},
@@ -273,7 +281,7 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
         "format": FORMAT,
         "baseline": {"train_rmse_mm": baseline.train_rmse_mm, "holdout_rmse_mm": base_rmse,
                      "report_rmse_mm": base_report_rmse, "noise_mm": noise,
-                     "noise_floor_mm": None if noise is None else float(np.sqrt(3) * noise),
+                     "noise_floor_mm": floor,
                      "residual_significant": is_significant_residual(base_rmse, noise),
                      "improved_by": improved_by, "fit": baseline.as_dict()},
         "constant_curvature": {**reference.as_dict(), "holdout_rmse_mm": rmse_mm(reference_errors),

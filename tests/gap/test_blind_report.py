@@ -6,6 +6,7 @@ from crest.reports.blind_report import confusion_markdown, write_blind_report
 def case(index, kind, truth, predicted, predicted_shrink, oracle):
     return {"case": index, "kind": kind, "truth": truth, "predicted": predicted or "none",
             "predicted_effects": [predicted] if predicted else [], "predicted_shrink": predicted_shrink,
+            "holdout_rmse_before_mm": 1.0, "holdout_rmse_after_mm": 1.0 - predicted_shrink, "noise_floor_mm": 0.17,
             "oracle_shrink": oracle, "shrink_error_pp": 100 * abs(predicted_shrink - oracle),
             "effect_rms_mm": 0.8, "noise_mm": 0.1, "above_noise": True, "relative_size": 0.8,
             "above_detection_limit": True}
@@ -32,6 +33,9 @@ def test_report_writes_markdown_and_figures(tmp_path):
     assert "| top-1 above the detection limit | 50% of 2 | >= 90% |" in text
     assert "| dahl | 3 | torsion | the plant failed in 6 draws |" in text
     assert "| backlash | 0.7-1 | 1 | 100% |" in text       # the detection-limit table
+    # the backlash verdict takes its log down to the noise floor: confident, and right
+    assert "| `confident` verdicts above the detection limit: right / wrong | 1 / 0 | - / 0 |" in text
+    assert "| clean cases with a catalog effect named `confident` | 0 | 0 |" in text
     assert (tmp_path / "blind" / "confusion_dahl.png").stat().st_size > 1000
     assert (tmp_path / "blind" / "detection_dahl.png").stat().st_size > 1000
     assert (tmp_path / "blind" / "shrink.png").stat().st_size > 1000

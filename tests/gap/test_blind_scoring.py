@@ -19,7 +19,8 @@ def test_draw_holds_clean_single_and_pair_cases_with_hidden_plants():
 
 
 def row(kind, truth, predicted, effects=None, predicted_shrink=0.5, oracle=0.5):
-    return {"kind": kind, "truth": truth, "predicted": predicted,
+    return {"kind": kind, "truth": truth, "predicted": predicted, "holdout_rmse_before_mm": 1.0,
+            "holdout_rmse_after_mm": 1.0 - predicted_shrink, "noise_floor_mm": 0.17,
             "predicted_effects": effects if effects is not None else ([] if predicted == "none" else [predicted]),
             "shrink_error_pp": 100 * abs(predicted_shrink - oracle)}
 
@@ -55,6 +56,24 @@ def test_clean_cases_count_none_and_unexplained_as_right_and_out_of_catalog_case
     assert result["unexplained_out_of_catalog"] == 0.5 and result["catalog_effect_out_of_catalog"] == 1
     assert result["confusion"]["stiffness_step"]["torsion"] == 1 and result["counts"]["out_of_catalog"] == 2
     assert result["shrink_error_pp"] is None        # no case with a catalog effect: nothing to compare
+
+
+def test_catalog_effects_that_halve_the_gap_count_as_confident_and_stored_rows_are_graded_from_their_errors():
+    def named(kind, truth, predicted, before_mm, after_mm, **stored):
+        return {**row(kind, truth, predicted), "holdout_rmse_before_mm": before_mm, "holdout_rmse_after_mm": after_mm,
+                "noise_floor_mm": 0.2, "above_detection_limit": True, **stored}
+
+    rows = [named("out_of_catalog", ["stiffness_step"], "lumen_compression", 2.5, 1.4),
+            named("out_of_catalog", ["sheath_creep"], "torsion", 2.5, 1.0),        # stored before the grade
+            named("out_of_catalog", ["sheath_creep"], "unexplained", 2.5, 2.5),
+            named("single", ["backlash"], "backlash", 3.0, 0.3, predicted_confidence="confident"),
+            named("single", ["gravity"], "precurvature", 1.0, 0.4),
+            named("single", ["gravity"], "gravity", 1.0, 0.9),
+            named("none", [], "sensor_offset", 1.0, 0.45)]
+    result = score(rows)
+    assert result["catalog_effect_out_of_catalog"] == 2 and result["confident_catalog_effect_out_of_catalog"] == 1
+    assert result["confident_single_above_detection"] == {"right": 1, "wrong": 1}
+    assert result["confident_catalog_effect_clean"] == 1
 
 
 def test_detection_curve_bins_top1_by_effect_size_relative_to_the_baseline_residual():

@@ -82,6 +82,10 @@ def test_crest_gap_runs_its_fits_on_the_scheduler(cluster, tmp_path):
     assert said in run.stdout and said in (tmp_path / "report" / "report.md").read_text()
     result = json.loads((tmp_path / "gap.json").read_text())
     assert result["verdict"]["effect"] == "backlash"
+    # a gear play alone is most of the gap: the grade says so on stdout and in the report
+    assert result["verdict"]["confidence"] == "confident"
+    assert result["verdict"]["confidence_line"] in run.stdout.splitlines()
+    assert f"- {result['verdict']['confidence_line']}" in (tmp_path / "report" / "report.md").read_text()
     assert {c["effect"] for c in result["candidates"]} == set(SETTINGS.effects)
     # the logs come from a model plant written straight to files: no virtual testbed's plant in their sidecars
     assert result["log_plants"] == {str(train): None, str(holdout): None}

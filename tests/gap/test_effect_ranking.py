@@ -21,7 +21,7 @@ def test_clean_plant_gives_none():
     result = diagnosed(None)
     verdict = result["verdict"]
     assert verdict["effect"] == "none" and verdict["effects"] == []
-    assert verdict["shrink"] == 0.0
+    assert verdict["shrink"] == 0.0 and verdict["confidence"] is None
     assert verdict["holdout_rmse_after_mm"] == verdict["holdout_rmse_before_mm"]
     # the calibrated base model alone is at the noise floor: nothing left to explain
     assert result["baseline"]["holdout_rmse_mm"] < 1.5 * result["baseline"]["noise_floor_mm"]

@@ -26,6 +26,7 @@ def test_result_matches_the_documented_json_shape():
     assert isinstance(verdict["effect"], str) and isinstance(verdict["effects"], list)
     assert isinstance(verdict["holdout_rmse_before_mm"], float) and isinstance(verdict["holdout_rmse_after_mm"], float)
     assert 0.0 <= verdict["shrink"] <= 1.0
+    assert verdict["confidence"] in ("confident", "partial", None) and "confidence_line" in verdict
     cc = result["constant_curvature"]      # the calibrated reference, on the same rows
     assert isinstance(cc["holdout_rmse_mm"], float) and len(cc["zero_offsets_mm"]) == 4
     assert [row["recording"] for row in result["holdout_by_recording"]] == result["settings"]["holdout"]

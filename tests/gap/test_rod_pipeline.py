@@ -59,7 +59,7 @@ def test_rod_without_effects_names_no_catalog_effect_and_describes_the_model_for
     no catalog effect may absorb it."""
     result = rod_diagnosis()
     verdict = result["verdict"]
-    assert verdict["effect"] == "unexplained" and verdict["effects"] == []
+    assert verdict["effect"] == "unexplained" and verdict["effects"] == [] and verdict["confidence"] is None
     assert result["baseline"]["residual_significant"]
     assert verdict["model_form_rms_mm"] > result["baseline"]["noise_floor_mm"]
     assert verdict["rejected"] and all(row["reasons"] for row in verdict["rejected"])
