@@ -47,7 +47,7 @@ def real_data_table(data_dir: Path | None, settings: DiagnosisSettings, progress
     with report_dir, each fold's gap report (`crest gap --report`) goes to report_dir/fold_K.
 
     Returns {"format", "data_dir", "rows": [{"recording", "fold", "trained_on", "constant_curvature_mm",
-    "dahl_mm", "dahl_verdict_mm", "verdict"}], "diagnoses": [the diagnosis result of each fold]}.
+    "dahl_mm", "dahl_verdict_mm", "verdict", "confidence"}], "diagnoses": [the diagnosis result of each fold]}.
     """
     folder = Path(data_dir) if data_dir else default_data_dir()
     missing = real_data_missing(folder)
@@ -72,7 +72,8 @@ def real_data_table(data_dir: Path | None, settings: DiagnosisSettings, progress
                 rows.append({"recording": Path(row["recording"]).stem, "fold": k + 1,
                              "trained_on": [p.stem for p in train],
                              "constant_curvature_mm": row["constant_curvature_mm"], "dahl_mm": row["baseline_mm"],
-                             "dahl_verdict_mm": row["verdict_mm"], "verdict": result["verdict"]["effect"]})
+                             "dahl_verdict_mm": row["verdict_mm"], "verdict": result["verdict"]["effect"],
+                             "confidence": result["verdict"]["confidence"]})
     return {"format": FORMAT, "data_dir": str(folder), "rows": sorted(rows, key=lambda row: row["recording"]),
             "diagnoses": diagnoses}
 
@@ -83,5 +84,6 @@ def table_markdown(table: dict) -> str:
              "|---|---|---|---|---|---|"]
     for row in table["rows"]:
         lines.append(f"| {row['recording']} | {row['fold']} | {row['constant_curvature_mm']:.2f} mm | "
-                     f"{row['dahl_mm']:.2f} mm | {row['dahl_verdict_mm']:.2f} mm | {row['verdict']} |")
+                     f"{row['dahl_mm']:.2f} mm | {row['dahl_verdict_mm']:.2f} mm | {row['verdict']}"
+                     + (f" ({row['confidence']}) |" if row["confidence"] else " |"))
     return "\n".join(lines)

@@ -14,10 +14,12 @@ def test_files_are_dealt_alternately_by_name_so_each_is_held_out_exactly_once():
     assert sorted(first + second) == sorted(paths)
 
 
-def test_the_table_has_one_row_per_held_out_file_with_the_three_models():
-    table = {"rows": [{"recording": "max_sweep", "fold": 1, "constant_curvature_mm": 10.234,
-                       "dahl_mm": 3.111, "dahl_verdict_mm": 3.0, "verdict": "tracker_offset"}]}
-    assert table_markdown(table).splitlines()[-1] == "| max_sweep | 1 | 10.23 mm | 3.11 mm | 3.00 mm | tracker_offset |"
+def test_the_table_has_one_row_per_held_out_file_with_the_three_models_and_the_verdicts_grade():
+    row = {"recording": "max_sweep", "fold": 1, "constant_curvature_mm": 10.234, "dahl_mm": 3.111,
+           "dahl_verdict_mm": 3.0, "verdict": "tracker_offset", "confidence": "partial"}
+    lines = table_markdown({"rows": [row, {**row, "verdict": "unexplained", "confidence": None}]}).splitlines()
+    assert lines[-2] == "| max_sweep | 1 | 10.23 mm | 3.11 mm | 3.00 mm | tracker_offset (partial) |"
+    assert lines[-1] == "| max_sweep | 1 | 10.23 mm | 3.11 mm | 3.00 mm | unexplained |"
 
 
 def test_a_missing_data_folder_is_one_error_line_before_any_work(tmp_path):
