@@ -237,9 +237,9 @@ def format_family_score(family: str, score: dict) -> str:
                      f"a catalog effect named in {score['catalog_effect_out_of_catalog']}, confidently in "
                      f"{score['confident_catalog_effect_out_of_catalog']} (target: never)")
     confident = score["confident_single_above_detection"]
-    lines.append(f"confident verdicts (the named effect at least halves the report half's error above the noise floor): above the detection "
-                 f"limit {confident['right']} right and {confident['wrong']} wrong; on clean cases "
-                 f"{score['confident_catalog_effect_clean']}")
+    lines.append("confident verdicts (the named effect at least halves the report half's error above the noise "
+                 f"floor): above the detection limit {confident['right']} right and {confident['wrong']} wrong; "
+                 f"on clean cases {score['confident_catalog_effect_clean']}")
     return "\n".join(lines)
 
 

@@ -23,10 +23,10 @@ curve, top-1 per effect against the effect's size relative to the baseline resid
 (`none` and `unexplained` both right); on out-of-catalog cases the share `unexplained` and the
 number with a catalog effect named, and how many of those the verdict grades `confident`
 (`model.gap.verdict_confidence`: the named effect at least halves the report half's error above
-the noise floor; the
-same count on clean cases, and confident right and wrong verdicts above the detection limit); how often the true effect is the best-ranked candidate above
-the detection limit (the verdict names a candidate or nothing, so this bounds the top-1 that any
-verdict rule could reach on these fits); the largest share of the error any candidate removed on
+the noise floor; the same count on clean cases, and the confident right and wrong verdicts above
+the detection limit); how often the true effect is the best-ranked candidate above the detection
+limit (the verdict names a candidate or nothing, so this bounds the top-1 that any verdict rule
+could reach on these fits); the largest share of the error any candidate removed on
 clean and on out-of-catalog cases (what catalog effects can take up where the catalog holds
 nothing); pair accuracy (dahl); and the error of the published shrink
 against an oracle shrink on the same report half of the held-out log
