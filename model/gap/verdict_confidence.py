@@ -26,12 +26,15 @@ PARTIAL = "partial"
 CONFIDENT_SHARE = 0.5
 
 
+def gap_mm(error_mm: float, noise_floor_mm: float | None) -> float:
+    """gap(e) = sqrt(max(e^2 - f^2, 0)): the error above the noise floor (f = 0 when unknown)."""
+    return math.sqrt(max(error_mm ** 2 - (noise_floor_mm or 0.0) ** 2, 0.0))
+
+
 def explained_share(before_mm: float, after_mm: float, noise_floor_mm: float | None) -> float:
     """The share of the held-out error above the noise floor that the verdict removes (see module doc)."""
-    floor2 = (noise_floor_mm or 0.0) ** 2
-    gap_before = math.sqrt(max(before_mm ** 2 - floor2, 0.0))
-    gap_after = math.sqrt(max(after_mm ** 2 - floor2, 0.0))
-    return 1.0 - gap_after / gap_before if gap_before > 0 else 0.0
+    gap_before = gap_mm(before_mm, noise_floor_mm)
+    return 1.0 - gap_mm(after_mm, noise_floor_mm) / gap_before if gap_before > 0 else 0.0
 
 
 def confidence(effects: list[str], before_mm: float, after_mm: float, noise_floor_mm: float | None) -> str | None:
@@ -49,10 +52,9 @@ def confidence_line(effects: list[str], before_mm: float, after_mm: float, noise
         return None
     share = explained_share(before_mm, after_mm, noise_floor_mm)
     floor = "" if noise_floor_mm is None else f" above the {noise_floor_mm:.3f} mm noise floor"
-    stays = math.sqrt(max(after_mm ** 2 - (noise_floor_mm or 0.0) ** 2, 0.0))
     said = (f"{' + '.join(effects)} removes {100 * share:.0f} % of the held-out error{floor} on the report half "
             f"({100 * CONFIDENT_SHARE:.0f} % makes a verdict confident)")
     if grade == CONFIDENT:
         return f"confident: {said}: most of the gap"
-    return (f"partial: {said}: {stays:.3f} mm RMS of the gap stays, most of it; model form, an effect outside "
+    return (f"partial: {said}: {gap_mm(after_mm, noise_floor_mm):.3f} mm RMS of the gap stays, most of it; model form, an effect outside "
             "the catalog, or this effect only in part")
