@@ -52,9 +52,12 @@ def confidence_line(effects: list[str], before_mm: float, after_mm: float, noise
         return None
     share = explained_share(before_mm, after_mm, noise_floor_mm)
     floor = "" if noise_floor_mm is None else f" above the {noise_floor_mm:.3f} mm noise floor"
-    said = (f"{' + '.join(effects)} removes {100 * share:.0f} % of the held-out error{floor} on the report half "
-            f"({100 * CONFIDENT_SHARE:.0f} % makes a verdict confident)")
+    named, error = " + ".join(effects), f"the held-out error{floor} on the report half"
+    said = f"{named} removes {100 * share:.0f} % of {error}" if share >= 0.0 else \
+        f"{named} makes {error} {-100 * share:.0f} % larger (it was selected on the other half)"
+    said += f" ({100 * CONFIDENT_SHARE:.0f} % makes a verdict confident)"
     if grade == CONFIDENT:
         return f"confident: {said}: most of the gap"
-    return (f"partial: {said}: {gap_mm(after_mm, noise_floor_mm):.3f} mm RMS of the gap stays, most of it; model form, an effect outside "
-            "the catalog, or this effect only in part")
+    stays = "most of it" if share >= 0.0 else "all of it"
+    return (f"partial: {said}: {gap_mm(after_mm, noise_floor_mm):.3f} mm RMS of the gap stays, {stays}; model form, an "
+            "effect outside the catalog, or this effect only in part")

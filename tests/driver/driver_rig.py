@@ -37,18 +37,23 @@ WAIT_S = 10.0
 START_TIMEOUT_S = 60.0
 #: Where the insertion carriage stands at power-up: 1 mm above its limit switch (home, 20 mm).
 INSERTION_START_MM = 21.0
+#: Wall time a simulated drive may take to answer an SDO on a loaded machine (as tests/serve's relaxed timing).
+LOADED_SDO_TIMEOUT_S = 2.0
 STOPPED_STATES = {"QUICK_STOP_ACTIVE", "SWITCH_ON_DISABLED", "FAULT"}
 
 
 def make_config(**master_overrides) -> TestbedConfig:
-    """configs/testbed.toml, with ``master_overrides`` replacing fields of its [master] table.
+    """configs/testbed.toml, with ``master_overrides`` replacing fields of its [master] table, and
+    the SDO timeout LOADED_SDO_TIMEOUT_S unless overridden.
 
     The SDO and boot timeouts are wall time: the simulated drives answer from their own process,
-    which a loaded machine can hold back for well over 0.1 s. Only a test that expects the timeout
-    to expire should shorten it.
+    which a loaded machine can hold back for well over 0.1 s, and past the configured 0.5 s once
+    (a boot's identity read, `pytest -n 3` on two cores, 2026-12-07). Only a test that expects the
+    timeout to expire should shorten it.
     """
     config = load_testbed_config()
-    return replace(config, master=replace(config.master, **master_overrides))
+    master = {"sdo_timeout_s": LOADED_SDO_TIMEOUT_S, **master_overrides}
+    return replace(config, master=replace(config.master, **master))
 
 
 def drive_specs(config: TestbedConfig, insertion_start_mm: float = INSERTION_START_MM) -> list[DriveSpec]:

@@ -36,6 +36,15 @@ def test_a_partial_grade_says_how_much_of_the_gap_stays():
     assert "1.990 mm RMS of the gap stays" in line
 
 
+def test_a_verdict_that_makes_the_report_half_worse_says_so():
+    """Rod seed 96, case 8: a sheath compression (out of catalog) named `rate_lag`, selected on the even
+    blocks, made the odd blocks' error larger (report shrink -0.055)."""
+    line = confidence_line(["rate_lag"], 0.80, 0.85, 0.1)
+    assert line.startswith("partial: rate_lag makes the held-out error above the 0.100 mm noise floor on the "
+                           "report half 6 % larger (it was selected on the other half)")
+    assert "removes" not in line and "stays, all of it" in line
+
+
 def test_a_pair_is_graded_on_its_joint_errors():
     assert confidence(["precurvature", "tracker_offset"], 1.0, 0.45, None) == CONFIDENT
     assert confidence_line(["precurvature", "tracker_offset"], 1.0, 0.45, None).startswith(
