@@ -137,7 +137,7 @@ def signature_region(name: str, features: SampleFeatures) -> np.ndarray:
 def _region_masks(f: SampleFeatures) -> dict:
     """{region name: a function giving its mask}, for the located regions (see module doc)."""
     return {
-        "zero load": lambda: f.articulation_deg < ZERO_LOAD_DEG,
+        STRAIGHT_REGION: lambda: f.articulation_deg < ZERO_LOAD_DEG,
         "high articulation": lambda: f.articulation_deg >= HIGH_ARTICULATION_DEG,
         "high tension": lambda: f.tension_n >= np.median(f.tension_n),
         "after reversal": lambda: f.motion == "after reversal",
