@@ -166,6 +166,8 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
     features = compute_features(held, zeros, tensions)
     chosen_features = features.subset(split.selection_mask)
 
+    largest_tension = max((t for t in (r.max_summed_tension_n for r in train) if t is not None), default=None)
+
     def rejections(result: CandidateResult, before: CandidateResult | None = None) -> list[str]:
         """Why the result is not a found effect (empty: it is). It must have predicted every held-out
         sample; be meaningful (selection half) against the baseline (`before`: the single it adds a
@@ -191,7 +193,8 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
                            f"reaches {rmse_mm(split.selected(result.ablated_holdout_errors)):.3f} mm")
         added = result.effects[-1]
         reasons += range_reasons(added, result.fit.effects[added], train[0].flexible_length_mm,
-                                 1.0 / res.fit_rate_hz, train[0].flexible_length_mm / res.n_elements)
+                                 1.0 / res.fit_rate_hz, train[0].flexible_length_mm / res.n_elements,
+                                 largest_tension)
         reasons += signature_reasons(added, chosen_features, np.concatenate(before_errors),
                                      np.concatenate(split.selected(result.holdout_errors)), noise)[0]
         reasons += hold_drift_reasons(added, features, split.selection_mask, np.concatenate(before_all),

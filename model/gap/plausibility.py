@@ -14,7 +14,15 @@ Two checks, each giving a reason when it fails (a fit that passes both has no re
    parameters then act as one, a softer base element, which is not the compression the effect
    describes: on the rod plant, a stiffness step (out of catalog) was named lumen_compression with
    extents of 3.5-4.2 mm on three seeds at 12.5 mm elements, while every lumen compression the
-   Dahl family's seeds named had 15-34 mm. A
+   Dahl family's seeds named had 15-34 mm. Nor may it push a lumen more than half way to the
+   neutral axis: at the base the moment arm is r / (1 + c sum_k T_k) (model.quasi_static_kernel),
+   so with the largest summed drive tension the training logs measured, T_max, the squeeze
+   X = c T_max may reach MAX_LUMEN_SQUEEZE = 1 (the arm at half the lumen offset), no more. A wall
+   that gives that far under a few newtons is no longer a lumen displaced by its load but a
+   different catheter: a softer one, or one with its curvature elsewhere (model form). On the rod
+   plant, whose own lumen compression shortens the arm to r^2 / (r + c_rod T), at most 0.6 r over
+   its drawing range, the stiffness steps (out of catalog) named lumen_compression on seeds 91,
+   96 and 98 needed X = 2.0, 2.4 and 1.9, the true lumen compression seed 98 named X = 0.82. A
    rate lag must be resolvable at the fits' sampling: its time constant at least
    MIN_LAG_SAMPLES of a (decimated) sample period. A lag shorter than that moves each sample by
    less than it moves between samples; with tau -> 0 the creep s + tau ds/dt = c T is the
@@ -117,6 +125,7 @@ ZERO_LOAD_DEG = 15.0
 HIGH_ARTICULATION_DEG = 45.0
 FAST_MM_S = 2.0
 NEAR_BASE_FRACTION = 0.5
+MAX_LUMEN_SQUEEZE = 1.0
 MIN_EXTENT_ELEMENTS = 0.5
 MIN_LAG_SAMPLES = 0.5
 MIN_HOLD_SAMPLES = 3
@@ -147,12 +156,21 @@ def _region_masks(f: SampleFeatures) -> dict:
 
 
 def range_reasons(effect_id: str, values: tuple[float, ...], flexible_length_mm: float | None = None,
-                  sample_period_s: float | None = None, element_length_mm: float | None = None) -> list[str]:
+                  sample_period_s: float | None = None, element_length_mm: float | None = None,
+                  max_summed_tension_n: float | None = None) -> list[str]:
     """Why the effect's fitted values are implausible (empty: plausible); flexible_length_mm: the
-    catheter's, sample_period_s: the fits' sample period, and element_length_mm: the length of an
-    element of the fits' model, for the effects whose range depends on them (None: not checked)."""
+    catheter's, sample_period_s: the fits' sample period, element_length_mm: the length of an
+    element of the fits' model, and max_summed_tension_n: the largest sum of the four drive tensions
+    the training logs measured, for the effects whose range depends on them (None: not checked)."""
     candidate = effect(effect_id)
     reasons = []
+    if effect_id == "lumen_compression" and max_summed_tension_n is not None \
+            and values[0] * max_summed_tension_n > MAX_LUMEN_SQUEEZE:
+        squeeze = values[0] * max_summed_tension_n
+        reasons.append(f"lumen_compression.coef_per_n = {values[0]:.3g} /N at the largest summed drive tension of the "
+                       f"training logs ({max_summed_tension_n:.3g} N) shrinks the moment arm at the base to "
+                       f"{1.0 / (1.0 + squeeze):.0%} of the lumen offset: a lumen pushed more than half way to the "
+                       "neutral axis is not a wall giving under load but another catheter (softer, or bent elsewhere)")
     if effect_id == "rate_lag" and sample_period_s is not None and values[1] < MIN_LAG_SAMPLES * sample_period_s:
         reasons.append(f"rate_lag.time_s = {values[1]:.3g} s is shorter than {MIN_LAG_SAMPLES:g} of the fits' sample "
                        f"period ({sample_period_s:g} s): a lag that short is not resolved, it is an elastic drive "

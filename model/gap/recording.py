@@ -76,6 +76,14 @@ class Recording:
         """Median time between samples."""
         return float(np.median(np.diff(self.t_s)))
 
+    @property
+    def max_summed_tension_n(self) -> float | None:
+        """The largest sum of the four measured tendon tensions over the samples (missing values count
+        as 0), or None when the log has no tensions or none is finite."""
+        if self.tendon_force_n is None or not np.isfinite(self.tendon_force_n).any():
+            return None
+        return float(np.max(np.nansum(self.tendon_force_n, axis=1)))
+
     @functools.cached_property
     def input_digest(self) -> bytes:
         """A digest of what drives the model (times, tendon and insertion positions): equal inputs, equal runs."""

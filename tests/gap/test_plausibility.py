@@ -9,6 +9,7 @@ from model import CatheterParams, DahlCatheter
 from model.effects import combined_terms
 from model.gap.plausibility import (LOSS_FRACTION, MIN_SIGNATURE_CONCENTRATION, hold_drift_reasons, hold_drift_rms_mm,
                                     range_reasons, signature_reasons)
+from model.gap.recording import Recording
 from model.gap.significance import is_meaningful
 from model.gap.sample_features import SampleFeatures
 from tests.model.conftest import articulation
@@ -160,6 +161,27 @@ def test_lumen_compression_along_the_whole_catheter_is_not_near_the_base():
     assert range_reasons("lumen_compression", (0.03, 20.0), flexible_length_mm=100.0) == []
     reasons = range_reasons("lumen_compression", (0.01, 181.0), flexible_length_mm=100.0)
     assert len(reasons) == 1 and "flexible length" in reasons[0]
+
+
+def test_a_lumen_pushed_more_than_half_way_to_the_neutral_axis_is_implausible():
+    """The arm at the base is r / (1 + c T_max) at the largest summed drive tension T_max: c T_max = 1
+    halves it, the bound. The values are rod seed 98's: its true lumen compression (c = 0.044 /N at
+    18.6 N: the arm at 55 %) and the stiffness step named lumen_compression (0.35 /N at 5.4 N: 35 %)."""
+    assert range_reasons("lumen_compression", (0.044, 7.3), max_summed_tension_n=18.6) == []
+    assert range_reasons("lumen_compression", (0.05, 20.0), max_summed_tension_n=20.0) == []     # exactly half
+    reasons = range_reasons("lumen_compression", (0.35, 16.5), max_summed_tension_n=5.4)
+    assert len(reasons) == 1 and "35% of the lumen offset" in reasons[0] and "half way" in reasons[0]
+    assert range_reasons("lumen_compression", (0.35, 16.5)) == []           # a log without tensions: not checked
+    assert range_reasons("tendon_elasticity", (0.35,), max_summed_tension_n=5.4) == []
+
+
+def test_the_largest_summed_tension_counts_missing_tendons_as_slack():
+    t = np.arange(4.0)
+    force = np.array([[1.0, 2.0, 0.0, 0.0], [6.0, np.nan, 0.5, 0.0], [3.0, 3.0, 0.0, 0.0], [np.nan] * 4])
+    recording = Recording("r", t, np.zeros((4, 4)), np.full(4, 80.0), np.zeros((4, 3)), force, 100.0, 2.5, None)
+    assert recording.max_summed_tension_n == 6.5
+    assert replace(recording, tendon_force_n=None).max_summed_tension_n is None
+    assert replace(recording, tendon_force_n=np.full((4, 4), np.nan)).max_summed_tension_n is None
 
 
 def test_lumen_compression_shorter_than_half_an_element_is_not_resolved():
