@@ -20,9 +20,10 @@ Two checks, each giving a reason when it fails (a fit that passes both has no re
    X = c T_max may reach MAX_LUMEN_SQUEEZE = 1 (the arm at half the lumen offset), no more. A wall
    that gives that far under a few newtons is no longer a lumen displaced by its load but a
    different catheter: a softer one, or one with its curvature elsewhere (model form). On the rod
-   plant, whose own lumen compression shortens the arm to r^2 / (r + c_rod T), at most 0.6 r over
-   its drawing range, the stiffness steps (out of catalog) named lumen_compression on seeds 91,
-   96 and 98 needed X = 2.0, 2.4 and 1.9, the true lumen compression seed 98 named X = 0.82. A
+   plant, whose own lumen compression shortens the arm to r^2 / (r + c_rod T) (0.53 r at its
+   drawing range's top, 0.1 mm/N, at 20 N with its r = 2.3 mm), the stiffness steps (out of
+   catalog) named lumen_compression on seeds 91, 96 and 98 needed X = 1.5, 2.4 and 1.9, the true
+   lumen compression seed 98 named X = 0.82. A
    rate lag must be resolvable at the fits' sampling: its time constant at least
    MIN_LAG_SAMPLES of a (decimated) sample period. A lag shorter than that moves each sample by
    less than it moves between samples; with tau -> 0 the creep s + tau ds/dt = c T is the
