@@ -165,9 +165,9 @@ def range_reasons(effect_id: str, values: tuple[float, ...], flexible_length_mm:
     the training logs measured, for the effects whose range depends on them (None: not checked)."""
     candidate = effect(effect_id)
     reasons = []
-    if effect_id == "lumen_compression" and max_summed_tension_n is not None \
-            and values[0] * max_summed_tension_n > MAX_LUMEN_SQUEEZE:
-        squeeze = values[0] * max_summed_tension_n
+    squeeze = values[0] * max_summed_tension_n \
+        if effect_id == "lumen_compression" and max_summed_tension_n is not None else 0.0
+    if squeeze > MAX_LUMEN_SQUEEZE:
         reasons.append(f"lumen_compression.coef_per_n = {values[0]:.3g} /N at the largest summed drive tension of the "
                        f"training logs ({max_summed_tension_n:.3g} N) shrinks the moment arm at the base to "
                        f"{1.0 / (1.0 + squeeze):.0%} of the lumen offset: a lumen pushed more than half way to the "
