@@ -82,12 +82,12 @@ Two checks, each giving a reason when it fails (a fit that passes both has no re
    which the baseline can take up only in part (its tendon zeros bend the catheter sideways a little;
    nothing shifts it along its axis). A true offset leaves the straight samples no worse than noise
    explains (dahl seed 49's by noise alone, see `worse_regions`); a fit that makes them worse by more
-   put its offset where there is none, to take up error that grows with the bend. On the rod plant, a stiffness step (out of catalog) was named
-   sensor_offset with an axial offset of 0.70 and 0.81 mm (seeds 94 and 95): zero load went from
-   0.43 to 0.83 and from 0.47 to 0.93 mm, a loss of 0.078 and 0.079 of the fit's gain, just under
-   LOSS_FRACTION. Over every stored blind result, the 35 true sensor offsets the rod seeds named
-   gained in every region (smallest C_R 0.20), while all 7 sensor offsets named on out-of-catalog
-   cases lost in one (C_R -0.61 to -0.03).
+   put its offset where there is none, to take up error that grows with the bend. On the rod
+   plant, a stiffness step (out of catalog) was named sensor_offset with an axial offset of 0.70
+   and 0.81 mm (seeds 94 and 95): zero load went from 0.43 to 0.83 and from 0.47 to 0.93 mm, a loss
+   of 0.078 and 0.079 of the fit's gain, just under LOSS_FRACTION. Over every stored blind result,
+   the 35 true sensor offsets the rod seeds named gained in every region (smallest C_R 0.20), while
+   all 7 sensor offsets named on out-of-catalog cases lost in one (C_R -0.61 to -0.03).
 3. Holds: over each static hold H (a run of at least MIN_HOLD_SAMPLES consecutive "static" samples
    of one recording, all in the selection half) the error's drift d_H = e_last - e_first is the
    model's motion during the hold less the tip's. Its RMS over the holds,
