@@ -1,12 +1,15 @@
 """The motor and its position loop: the actual position lags the demand.
 
-Per communication cycle dt, with demand x_d, v_d and actual x, v (counts, counts/s):
+The drive runs its loop every h, at most 0.5 / K_p (10 ms), whatever the SYNC period: a
+communication cycle dt is n = ceil(dt / h_max) loop periods h = dt / n, in which the cycle's end
+demand x_d is walked back along v_d (loop k = 1..n ends at x_d - v_d (dt - k h)). Per loop period h,
+with demand x_d, v_d at its end and actual x, v (counts, counts/s):
 
-    e     = (x_d - v_d * dt) - x          tracking error at the start of the cycle
+    e     = (x_d - v_d * h) - x           tracking error at the start of the loop period
     v_cmd = v_d + sign(e) * min(K_p * |e|, sqrt(2 * a_max * |e|))
     v_cmd = clamp(v_cmd, -v_max, v_max)
-    v    <- v + clamp(v_cmd - v, -a_max * dt, a_max * dt)
-    x    <- x + (v_old + v) / 2 * dt
+    v    <- v + clamp(v_cmd - v, -a_max * h, a_max * h)
+    x    <- x + (v_old + v) / 2 * h
 
 i.e. a proportional position loop with velocity feed-forward. The correction is
 capped by sqrt(2 a_max |e|) so that a jump in the demand is approached without
@@ -20,8 +23,10 @@ from __future__ import annotations
 
 import math
 
-#: Position loop gain K_p (1/s). K_p * dt = 0.5 at a 10 ms cycle: no overshoot.
+#: Position loop gain K_p (1/s). K_p * h = 0.5 at the 10 ms loop period: no overshoot.
 DEFAULT_POSITION_GAIN_1_S = 50.0
+#: The longest loop period, as a fraction of 1 / K_p: beyond 1 the discrete loop overshoots, at 2 it oscillates.
+LOOP_GAIN_PER_PERIOD = 0.5
 
 
 class ServoAxis:
@@ -38,10 +43,17 @@ class ServoAxis:
         self.stalled = False
 
     def step(self, demand_counts: float, demand_velocity_counts_s: float, dt_s: float) -> None:
-        """Advance the energised motor by one cycle toward the demand."""
+        """Advance the energised motor by one communication cycle toward the demand at its end."""
         if self.stalled:
             self.velocity_counts_s = 0.0
             return
+        loops = max(1, math.ceil(dt_s * self.position_gain_1_s / LOOP_GAIN_PER_PERIOD - 1e-9))
+        loop_s = dt_s / loops
+        for k in range(1, loops + 1):
+            self._loop(demand_counts - demand_velocity_counts_s * (dt_s - k * loop_s), demand_velocity_counts_s, loop_s)
+
+    def _loop(self, demand_counts: float, demand_velocity_counts_s: float, dt_s: float) -> None:
+        """One period of the position loop (the module docstring, with h = dt_s)."""
         error = demand_counts - demand_velocity_counts_s * dt_s - self.position_counts
         correction = min(self.position_gain_1_s * abs(error),
                          math.sqrt(2.0 * self.max_acceleration_counts_s2 * abs(error)))

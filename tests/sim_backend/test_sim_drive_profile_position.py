@@ -146,3 +146,17 @@ def test_halt_stops_and_resumes(bench):
     bench.controlword(DRIVE, 0x0F)                # release: the target is still valid
     run_until_reached(bench)
     assert abs(position(bench) - 10_000) <= 20
+
+
+@pytest.mark.parametrize("sync_period_us", [20000, 40000, 100000])
+def test_a_long_sync_period_reaches_the_target_without_the_servo_oscillating(bench, sync_period_us):
+    """The drive's own position loop runs every 10 ms whatever the SYNC period (0x1006): a slow
+    SYNC changes how often the master sees the axis, not how the motor settles."""
+    bench.nodes[DRIVE].sdo[0x1006].raw = sync_period_us
+    bench.enable(DRIVE, PP)
+    new_set_point(bench, 2000)
+    bench.controlword(DRIVE, 0x0F)
+    positions = run_until_reached(bench, max_cycles=round(2.0e6 / sync_period_us))
+    assert abs(position(bench) - 2000) <= bench.nodes[DRIVE].sdo[0x6067].raw
+    overshoot_mm = (max(positions) - 2000) / bench.drive(DRIVE).spec.counts_per_mm
+    assert overshoot_mm < 0.05
