@@ -139,6 +139,20 @@ def test_bad_configuration_names_the_file_and_field(tmp_path):
     assert "sync.period_s" in result.stderr and str(bad) in result.stderr
 
 
+def test_a_testbed_with_a_40_ms_sync_moves_to_its_target(tmp_path):
+    """A slow SYNC is the user's choice: the virtual drives keep their own 10 ms position loops
+    (before, at 40 ms the simulated servo oscillated and the move ended in a safety stop)."""
+    from crest.config import default_config_path
+    text = default_config_path().read_text()
+    assert "period_s = 0.01 " in text
+    config = tmp_path / "testbed.toml"
+    config.write_text(text.replace("period_s = 0.01 ", "period_s = 0.04 "))
+    (tmp_path / "crest_drive.eds").write_text((default_config_path().parent / "crest_drive.eds").read_text())
+    result = crest("move", "--pitch", "30", "--yaw", "0", "--fast", "--config", str(config))
+    assert result.returncode == ExitCode.OK, result.stderr
+    assert "safety stop" not in result.stderr
+    assert "from the target" in result.stdout
+
 def test_bad_command_line_arguments_exit_with_usage():
     result = crest("move", "--pitch", "ten", "--yaw", "0")
     assert result.returncode == ExitCode.USAGE
