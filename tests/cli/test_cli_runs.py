@@ -153,6 +153,7 @@ def test_a_testbed_with_a_40_ms_sync_moves_to_its_target(tmp_path):
     assert "safety stop" not in result.stderr
     assert "from the target" in result.stdout
 
+
 def test_bad_command_line_arguments_exit_with_usage():
     result = crest("move", "--pitch", "ten", "--yaw", "0")
     assert result.returncode == ExitCode.USAGE
