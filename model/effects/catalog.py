@@ -14,9 +14,10 @@ EFFECTS: dict[str, CandidateEffect] = {e.id: e for e in (
         id="tendon_elasticity",
         physics="tendon and drive-line stretch under tension: the tip sees u - c*T_drive",
         param_names=("compliance_mm_per_n",), typical=(0.05,), lower=(0.0,), upper=(0.5,),
-        signature="articulation lags the command in proportion to tension, at every articulation; the "
-                  "calibrated base model takes up the part that grows with tension, so adding it removes "
-                  "error in every region of the motion and makes none worse",
+        signature="articulation lags the command in proportion to tension, at every articulation and most "
+                  "over the shortest free lengths (a bend needs the most tension there); the calibrated base "
+                  "model takes up the part that grows with tension, so adding it removes error in every region "
+                  "of the motion and makes none worse, the shortest free lengths least of all",
         signature_region="every region",
         apply=lambda t, v: t.replace(tendon_compliance_mm_per_n=v[0])),
     CandidateEffect(

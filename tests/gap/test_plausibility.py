@@ -157,6 +157,39 @@ def test_a_rigid_offset_may_not_make_the_straight_catheter_worse_at_all(effect_i
     assert signature_reasons(effect_id, fast_not_straight, before, after, noise_mm=0.05)[0] == []
 
 
+
+def shortest_made_worse(shortest_after_mm):
+    """(features, before, after): 1 mm tip error everywhere before, 10 samples at free lengths 55-60 mm
+    and 90 at 70-92 mm (the shortest quarter of 55-92 mm ends at 64.25 mm); after, the short ones
+    1 -> shortest_after_mm and the long ones 1 -> 0.2 mm."""
+    f = features([30.0] * 100)
+    f = replace(f, insertion_mm=np.r_[np.linspace(55.0, 60.0, 10), np.linspace(70.0, 92.0, 90)])
+    before = np.tile([1.0, 0.0, 0.0], (100, 1))
+    after = before.copy()
+    after[:10, 0], after[10:, 0] = shortest_after_mm, 0.2
+    return f, before, after
+
+
+def test_an_elastic_line_may_not_make_the_shortest_free_lengths_worse_at_all():
+    """A bend over a shorter free length needs more tension, so an elastic line stretches most there:
+    a fit that makes the shortest quarter of the free lengths worse beyond noise is rejected, even by a
+    loss of 0.05 of its whole gain (under LOSS_FRACTION; on the rod plant, a moment arm that shrinks
+    toward the tip, named tendon_elasticity, made it worse while the true elastic lines improved it).
+    Worse by noise alone, or better, it is found; other every-region effects get the usual allowance."""
+    f, before, after = shortest_made_worse(1.2)
+    loss_mm2, gain_mm2 = 10 * (1.2 ** 2 - 1.0), 90 * (1.0 - 0.2 ** 2)
+    assert loss_mm2 < LOSS_FRACTION * gain_mm2 and is_meaningful(1.2, 1.0, 0.05)
+    reasons, _ = signature_reasons("tendon_elasticity", f, before, after, noise_mm=0.05)
+    assert reasons and "shortest free lengths" in reasons[0] and "stretches most" in reasons[0]
+    assert signature_reasons("gravity", f, before, after, noise_mm=0.05)[0] == []
+    f, before, after = shortest_made_worse(1.01)
+    assert signature_reasons("tendon_elasticity", f, before, after, noise_mm=0.05)[0] == []
+    f, before, after = shortest_made_worse(0.5)
+    assert signature_reasons("tendon_elasticity", f, before, after, noise_mm=0.05)[0] == []
+    f, before, after = shortest_made_worse(1.2)
+    one_free_length = replace(f, insertion_mm=np.full(100, 80.0))    # no free lengths to tell apart
+    assert signature_reasons("tendon_elasticity", one_free_length, before, after, noise_mm=0.05)[0] == []
+
 def test_lumen_compression_along_the_whole_catheter_is_not_near_the_base():
     assert range_reasons("lumen_compression", (0.03, 20.0), flexible_length_mm=100.0) == []
     reasons = range_reasons("lumen_compression", (0.01, 181.0), flexible_length_mm=100.0)
