@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import os
 import pty
+import re
 import select
 import struct
 import subprocess
@@ -12,6 +13,7 @@ from pathlib import Path
 
 import can
 
+from crest.config import default_config_path
 from crest.driver.cia402 import ENERGISED_STATES, QUICK_STOP, state_from_statusword
 
 CREST = [sys.executable, "-m", "crest.cli.main"]
@@ -25,6 +27,20 @@ def crest(*args: str, timeout_s: float = 240.0, cwd: Path | None = None,
     env = dict(os.environ, PYTHONUNBUFFERED="1", **(env or {}))
     return subprocess.run([*CREST, *args], capture_output=True, text=True, timeout=timeout_s,
                           cwd=cwd or REPO, env=env)
+
+
+def edited_config(folder: Path, **values) -> Path:
+    """configs/testbed.toml with each `key = value` line given in `values` replaced (each key at the
+    start of exactly one line), written as folder/testbed.toml beside a copy of its EDS."""
+    text = default_config_path().read_text()
+    for key, value in values.items():
+        text, count = re.subn(rf"^{key} = \S+", f"{key} = {value}", text, flags=re.MULTILINE)
+        assert count == 1, key
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "crest_drive.eds").write_text((default_config_path().parent / "crest_drive.eds").read_text())
+    path = folder / "testbed.toml"
+    path.write_text(text)
+    return path
 
 
 def record_short_run(folder: Path) -> Path:

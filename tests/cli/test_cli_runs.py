@@ -9,7 +9,7 @@ import can
 import numpy as np
 import pytest
 
-from cli_runner import crest, start_crest
+from cli_runner import crest, edited_config, start_crest
 from crest.driver import AXIS_ORDER
 from crest.exit_codes import ExitCode
 from crest.log import read_log
@@ -129,11 +129,7 @@ def test_too_fast_setpoint_file_is_refused_before_anything_moves(tmp_path):
 
 
 def test_bad_configuration_names_the_file_and_field(tmp_path):
-    from crest.config import default_config_path
-    text = default_config_path().read_text().replace("period_s = 0.01", "period_s = -1.0")
-    bad = tmp_path / "testbed.toml"
-    bad.write_text(text)
-    (tmp_path / "crest_drive.eds").write_text((default_config_path().parent / "crest_drive.eds").read_text())
+    bad = edited_config(tmp_path, period_s=-1.0)
     result = crest("status", "--config", str(bad))
     assert result.returncode == ExitCode.CONFIG
     assert "sync.period_s" in result.stderr and str(bad) in result.stderr
@@ -142,12 +138,7 @@ def test_bad_configuration_names_the_file_and_field(tmp_path):
 def test_a_testbed_with_a_40_ms_sync_moves_to_its_target(tmp_path):
     """A slow SYNC is the user's choice: the virtual drives keep their own 10 ms position loops
     (before, at 40 ms the simulated servo oscillated and the move ended in a safety stop)."""
-    from crest.config import default_config_path
-    text = default_config_path().read_text()
-    assert "period_s = 0.01 " in text
-    config = tmp_path / "testbed.toml"
-    config.write_text(text.replace("period_s = 0.01 ", "period_s = 0.04 "))
-    (tmp_path / "crest_drive.eds").write_text((default_config_path().parent / "crest_drive.eds").read_text())
+    config = edited_config(tmp_path, period_s=0.04)
     result = crest("move", "--pitch", "30", "--yaw", "0", "--fast", "--config", str(config))
     assert result.returncode == ExitCode.OK, result.stderr
     assert "safety stop" not in result.stderr

@@ -11,8 +11,7 @@ import signal
 import subprocess
 import time
 
-from cli_runner import REPO, assert_every_drive_quick_stopped, crest, start_crest
-from crest.config import default_config_path
+from cli_runner import REPO, assert_every_drive_quick_stopped, crest, edited_config, start_crest
 from crest.driver.cia402 import QUICK_STOP
 from crest.exit_codes import ExitCode
 from crest.log import read_log
@@ -47,13 +46,8 @@ def real_bus_config(tmp_path):
     """configs/testbed.toml on a python-can bus that opens without hardware or network and has no
     drives on it (a serial loopback: every frame comes back to its sender, no drive answers),
     with [tracker].port still 'sim'."""
-    text = default_config_path().read_text()
-    text = text.replace('interface = "virtual"', 'interface = "serial"').replace('channel = "crest"',
-                                                                               'channel = "loop://"')
-    assert 'interface = "serial"' in text and 'port = "sim"' in text
-    path = tmp_path / "testbed.toml"
-    path.write_text(text)
-    (tmp_path / "crest_drive.eds").write_text((default_config_path().parent / "crest_drive.eds").read_text())
+    path = edited_config(tmp_path, interface='"serial"', channel='"loop://"')
+    assert 'port = "sim"' in path.read_text()
     return path
 
 

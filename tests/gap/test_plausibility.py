@@ -157,7 +157,6 @@ def test_a_rigid_offset_may_not_make_the_straight_catheter_worse_at_all(effect_i
     assert signature_reasons(effect_id, fast_not_straight, before, after, noise_mm=0.05)[0] == []
 
 
-
 def shortest_made_worse(shortest_after_mm):
     """(features, before, after): 1 mm tip error everywhere before, 10 samples at free lengths 55-60 mm
     and 90 at 70-92 mm (the shortest quarter of 55-92 mm ends at 64.25 mm); after, the short ones
@@ -189,6 +188,7 @@ def test_an_elastic_line_may_not_make_the_shortest_free_lengths_worse_at_all():
     f, before, after = shortest_made_worse(1.2)
     one_free_length = replace(f, insertion_mm=np.full(100, 80.0))    # no free lengths to tell apart
     assert signature_reasons("tendon_elasticity", one_free_length, before, after, noise_mm=0.05)[0] == []
+
 
 def test_lumen_compression_along_the_whole_catheter_is_not_near_the_base():
     assert range_reasons("lumen_compression", (0.03, 20.0), flexible_length_mm=100.0) == []

@@ -20,8 +20,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from crest.config import default_config_path
-from tests.cli.cli_runner import crest, start_crest
+from tests.cli.cli_runner import crest, edited_config, start_crest
 
 START_TIMEOUT_S = 300.0     # the first start in a fresh checkout compiles the plant's kernels
 STOP_TIMEOUT_S = 60.0
@@ -38,15 +37,7 @@ RELAXED_TIMING = {         # [master] key: value
 def relaxed_config(folder: Path, **changes) -> Path:
     """configs/testbed.toml with RELAXED_TIMING and `changes` (further key = value lines),
     written into `folder` with its EDS."""
-    text = default_config_path().read_text()
-    for key, value in {**RELAXED_TIMING, **changes}.items():
-        text, count = re.subn(rf"^{key} = \S+", f"{key} = {value}", text, flags=re.MULTILINE)
-        assert count == 1, key
-    folder.mkdir(parents=True, exist_ok=True)
-    (folder / "crest_drive.eds").write_text((default_config_path().parent / "crest_drive.eds").read_text())
-    path = folder / "testbed.toml"
-    path.write_text(text)
-    return path
+    return edited_config(folder, **{**RELAXED_TIMING, **changes})
 
 
 @dataclass
