@@ -46,7 +46,9 @@ EFFECTS: dict[str, CandidateEffect] = {e.id: e for e in (
         physics="sag under the catheter's own weight: element masses loaded by g across the insertion "
                 "axis, which the testbed holds horizontal (g in the base x-y plane, g_z = 0)",
         param_names=("g_x_m_s2", "g_y_m_s2"), typical=(0.0, -9.81),
-        lower=(-20.0, -20.0), upper=(20.0, 20.0),   # up to 2 g: a fluid-filled catheter weighs more
+        # g acts on the prior's linear density, which nobody weighed: up to 5 g is a catheter five times
+        # as heavy per mm as the bare shaft the prior describes (a fluid-filled lumen, a braid, a sensor cable)
+        lower=(-50.0, -50.0), upper=(50.0, 50.0),
         signature="a fixed-direction offset that grows with free length, present at every articulation "
                   "(zero load included): adding it removes error in every region of the motion",
         signature_region="every region",
@@ -99,7 +101,9 @@ EFFECTS: dict[str, CandidateEffect] = {e.id: e for e in (
                 "so the catheter follows the drive with a first-order lag that grows with tension",
         param_names=("compliance_mm_per_n", "time_s"), typical=(0.05, 0.3), lower=(0.0, 0.01), upper=(0.5, 5.0),
         signature="the tip trails fast motion (error along the motion, growing with speed) and keeps creeping "
-                  "without overshoot for ~tau after each stop; slow motion and settled holds agree",
+                  "without overshoot for ~tau after each stop; slow motion and settled holds agree; settled, it "
+                  "stretches as an elastic line does, most over the shortest free lengths, so adding it makes "
+                  "those no worse",
         signature_region="fast",
         apply=lambda t, v: t.replace(drive_creep_mm_per_n=v[0], drive_creep_time_s=v[1])),
 )}
