@@ -42,7 +42,8 @@ from model.gap.fit_pool import fit_pool, one_blas_thread
 from model.gap.free_parameters import base_values
 from model.gap.holdout_split import HoldoutSplit, split_holdout
 from model.gap.noise import tracker_noise_mm
-from model.gap.plausibility import hold_drift_reasons, range_reasons, signature_concentration, signature_reasons
+from model.gap.plausibility import (hold_drift_reasons, longest_hold_s, range_reasons, signature_concentration,
+                                    signature_reasons)
 from model.gap.recording import Recording, RecordingError
 from model.gap.regions import breakdown, concentrated, regions, shrink_by_region
 from model.gap.sample_features import SampleFeatures, compute_features
@@ -167,6 +168,7 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
     chosen_features = features.subset(split.selection_mask)
 
     largest_tension = max((t for t in (r.max_summed_tension_n for r in train) if t is not None), default=None)
+    hold_s = longest_hold_s(features, np.concatenate([r.t_s[r.valid] for r in held]))
 
     def rejections(result: CandidateResult, before: CandidateResult | None = None) -> list[str]:
         """Why the result is not a found effect (empty: it is). It must have predicted every held-out
@@ -194,7 +196,7 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
         added = result.effects[-1]
         reasons += range_reasons(added, result.fit.effects[added], train[0].flexible_length_mm,
                                  1.0 / res.fit_rate_hz, train[0].flexible_length_mm / res.n_elements,
-                                 largest_tension)
+                                 largest_tension, hold_s)
         reasons += signature_reasons(added, chosen_features, np.concatenate(before_errors),
                                      np.concatenate(split.selected(result.holdout_errors)), noise)[0]
         reasons += hold_drift_reasons(added, features, split.selection_mask, np.concatenate(before_all),
