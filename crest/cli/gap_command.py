@@ -21,6 +21,7 @@ from crest.gap.blind_combine import combined_result
 from crest.gap.fit_executor import check_scheduler_address, dask_executor, open_executor
 from crest.gap.log_diagnosis import diagnose_logs
 from crest.gap.log_recordings import load_recordings
+from crest.gap.miss_causes import CAUSE_WORDS, CAUSES
 from crest.gap.real_data_table import real_data_table, table_markdown
 from crest.log import recorded_plant
 from crest.reports.blind_report import write_blind_report
@@ -227,6 +228,10 @@ def format_family_score(family: str, score: dict) -> str:
     if counts.get("single_above_detection_with_candidates"):
         lines.append("the true effect ranked first among the candidates above the detection limit, the most any "
                      f"verdict rule could name: {_count(score['truth_ranked_first_above_detection'], counts['single_above_detection_with_candidates'])}")
+    misses = score["misses_above_detection"]
+    if any(misses[cause] for cause in CAUSES):
+        lines.append("misses above the detection limit, by cause: "
+                     + "; ".join(f"{misses[cause]} {CAUSE_WORDS[cause]}" for cause in CAUSES if misses[cause]))
     for kind, key in (("a clean", "largest_candidate_shrink_clean"),
                       ("an out-of-catalog", "largest_candidate_shrink_out_of_catalog")):
         if score.get(key) is not None:

@@ -26,7 +26,9 @@ number with a catalog effect named, and how many of those the verdict grades `co
 the noise floor; the same count on clean cases, and the confident right and wrong verdicts above
 the detection limit); how often the true effect is the best-ranked candidate above the detection
 limit (the verdict names a candidate or nothing, so this bounds the top-1 that any verdict rule
-could reach on these fits); the largest share of the error any candidate removed on
+could reach on these fits); the misses above the detection limit by cause (`crest.gap.miss_causes`:
+absorbed by the base model, the fitted true effect removing nothing significant, or the
+diagnosis's own); the largest share of the error any candidate removed on
 clean and on out-of-catalog cases (what catalog effects can take up where the catalog holds
 nothing); pair accuracy (dahl); and the error of the published shrink
 against an oracle shrink on the same report half of the held-out log
@@ -71,6 +73,7 @@ from crest.gap.effect_draws import DAHL_EFFECT_RANGES, catalog_ids, draw_effect,
 from crest.gap.isolated_call import CallTimedOut, call_isolated
 from crest.gap.log_diagnosis import diagnose_logs
 from crest.gap.log_recordings import load_recordings
+from crest.gap.miss_causes import miss_causes
 from crest.gap.synthetic_logs import Plant
 from crest.gap.visible_effect import visible_effect_mm
 from crest.session import SessionOptions, open_session
@@ -496,6 +499,7 @@ def score(all_rows: list[dict]) -> dict:
         "top1_single_above_visible_limit": fraction([r["predicted"] == r["truth"][0] for r in visible]),
         "truth_ranked_first_above_detection": fraction([r["candidates"][0]["effect"] == r["truth"][0]
                                                         for r in ranked]),
+        "misses_above_detection": miss_causes([r for r in detectable if r["predicted"] != r["truth"][0]]),
         "largest_candidate_shrink_clean": _largest_shrink(clean),
         "largest_candidate_shrink_out_of_catalog": _largest_shrink(outside),
         "visible_detection_curve": detection_curve(singles, "visible_relative_size"),

@@ -2,7 +2,7 @@
 
 - blind_benchmark.md: per plant family the scores against their targets, the confusion matrix
   (true effect -> verdict: single, clean and out-of-catalog cases), the detection-limit table,
-  and one line per case;
+  the misses above the detection limit by cause (`crest.gap.miss_causes`), and one line per case;
 - confusion_<family>.png: the confusion matrix as a heat map;
 - detection_<family>.png: top-1 per effect against the effect's size relative to the baseline
   residual (the detection-limit curve); on the rod family also against the effect's visible part
@@ -17,6 +17,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from crest.gap.blind_benchmark import ALL_EFFECTS
+from crest.gap.miss_causes import CAUSE_WORDS, CAUSES
 from crest.paper.figure_output import new_figure, save_png
 
 
@@ -134,6 +135,19 @@ def _family_markdown(family: str, score: dict) -> list[str]:
         lines += ["", "By the effect's visible part (the detection figure's right panel):", "",
                   "| effect | visible / residual | cases | top-1 |", "|---|---|---|---|"]
         lines += _curve_rows(score["visible_detection_curve"])
+    return lines + ["", *_miss_rows(score["misses_above_detection"])]
+
+
+def _miss_rows(misses: dict) -> list[str]:
+    """The misses above the detection limit per true effect and cause (`crest.gap.miss_causes`)."""
+    if not misses["by_effect"]:
+        return []
+    lines = ["### Misses above the detection limit, by cause", "",
+             *(f"- {cause}: {CAUSE_WORDS[cause]}" for cause in CAUSES), "",
+             "| effect | " + " | ".join(CAUSES) + " |", "|---" * (len(CAUSES) + 1) + "|"]
+    for effect_id, causes in misses["by_effect"].items():
+        lines.append(f"| {effect_id} | " + " | ".join(str(causes.get(cause, 0)) for cause in CAUSES) + " |")
+    lines.append("| all effects | " + " | ".join(str(misses[cause]) for cause in CAUSES) + " |")
     return lines + [""]
 
 

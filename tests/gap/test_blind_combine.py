@@ -5,6 +5,7 @@ import sys
 from pathlib import Path
 
 from crest.gap.blind_benchmark import ALL_EFFECTS
+from crest.gap.miss_causes import CAUSE_WORDS, CAUSES
 
 ROOT = Path(__file__).resolve().parents[2]
 STORED = [ROOT / "docs" / "blind_benchmark_rod" / f"seed{seed}" / "blind.json" for seed in (77, 78)]
@@ -40,6 +41,14 @@ def test_combined_seeds_count_every_case_of_each_seed(tmp_path):
     assert f"top-1 above the detection limit: {hits(combined, 'top1_single_above_detection', 'single_above_detection')} " \
            f"of {total}" in done.stdout
     assert "the true effect ranked first among the candidates" in done.stdout
+    # every miss above the detection limit is put down to one cause, on stdout and in the report
+    misses = combined["misses_above_detection"]
+    missed = total - hits(combined, "top1_single_above_detection", "single_above_detection")
+    assert sum(misses[cause] for cause in CAUSES) == missed > 0
+    line = next(text for text in done.stdout.splitlines() if text.startswith("misses above the detection limit"))
+    assert all(f"{misses[cause]} {CAUSE_WORDS[cause]}" in line for cause in CAUSES if misses[cause])
+    assert f"| all effects | {' | '.join(str(misses[cause]) for cause in CAUSES)} |" in \
+        (report / "blind_benchmark.md").read_text()
     # the detection-limit curve pooled over every effect holds each effect's cases, bin by bin
     for curve, title in (("detection_curve", "top-1 by the effect's size"),
                          ("visible_detection_curve", "top-1 by the visible part")):

@@ -2,6 +2,7 @@
 import pytest
 
 from crest.gap.blind_benchmark import ALL_EFFECTS, draw_cases, score
+from crest.gap.miss_causes import ABSORBED, CAUSES, DIAGNOSIS, NO_ORACLE, ORACLE_NOT_SIGNIFICANT, miss_cause
 from model import CatheterParams
 from model.effects import EFFECTS
 
@@ -150,3 +151,27 @@ def test_the_largest_candidate_shrink_where_the_catalog_holds_nothing_is_kept_pe
     assert result["largest_candidate_shrink_clean"] == 0.12
     assert result["largest_candidate_shrink_out_of_catalog"] == 0.4
     assert score([row("none", [], "none")])["largest_candidate_shrink_clean"] is None
+
+
+def test_a_miss_above_the_limit_is_put_down_to_absorption_to_the_fitted_truth_or_to_the_diagnosis():
+    """Before 1.0 mm on the report half, floor 0.17 mm (sigma 0.098): an oracle shrink of 0.4 removes 0.64
+    mm^2, above a quarter of the 0.97 mm^2 above the floor (significant); 0.1 removes 0.19 mm^2, below it."""
+    def missed(truth, oracle, **extra):
+        return {**row("single", [truth], "unexplained"), "above_detection_limit": True, "oracle_shrink": oracle,
+                **extra}
+    seen, hidden = {"visible_relative_size": 0.9, "above_visible_limit": True}, \
+        {"visible_relative_size": 0.05, "above_visible_limit": False}
+    rows = [missed("gravity", 0.4, **hidden),                  # the base model absorbs it: whatever its oracle
+            missed("lumen_compression", 0.1, **seen),          # visible, but its fitted form gains too little
+            missed("gravity", 0.4, **seen),                    # the diagnosis's own miss
+            missed("backlash", 0.4),                           # a Dahl case (no visible size): its own miss
+            missed("backlash", float("-inf")),                 # the oracle's prediction failed
+            {**row("single", ["tracker_offset"], "tracker_offset"), "above_detection_limit": True},    # a hit
+            {**missed("torsion", 0.0), "above_detection_limit": False}]                              # below it
+    misses = score(rows)["misses_above_detection"]
+    assert {cause: misses[cause] for cause in CAUSES} == {ABSORBED: 1, ORACLE_NOT_SIGNIFICANT: 1, DIAGNOSIS: 2,
+                                                          NO_ORACLE: 1}
+    assert misses["by_effect"] == {"backlash": {DIAGNOSIS: 1, NO_ORACLE: 1},
+                                   "gravity": {ABSORBED: 1, DIAGNOSIS: 1},
+                                   "lumen_compression": {ORACLE_NOT_SIGNIFICANT: 1}}
+    assert miss_cause({**missed("backlash", 0.4), "no_result": "timed out"}) == DIAGNOSIS
