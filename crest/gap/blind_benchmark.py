@@ -322,7 +322,7 @@ def oracle_shrinks(case: BlindCase, train: Path, holdout: Path, prior: CatheterP
     truth_errors = tip_errors(truth, held, res)
     without = tip_errors(ModelFit(truth.params, truth.zero_offsets_mm, {}), held, res)
     effect_rms_mm = rmse_mm([a - b for a, b in zip(truth_errors, without)])
-    split = split_holdout(held)
+    split = split_holdout([len(e) for e in truth_errors])
     fitted_shrink, exact_shrink = (1.0 - rmse_mm(split.reported(errors)) / baseline_rmse_mm
                                    for errors in (tip_errors(fitted, held, res), truth_errors))
     return fitted_shrink, exact_shrink, effect_rms_mm
@@ -336,7 +336,7 @@ def rod_oracle_shrink(effect_id: str, result: dict, train: Path, holdout: Path, 
     held = res.prepare(load_recordings([holdout]))
     baseline = ModelFit.from_dict(result["baseline"]["fit"])
     base_errors = tip_errors(baseline, held, res)
-    split = split_holdout(held)
+    split = split_holdout([len(e) for e in base_errors])
     fitted = run_task(FitTask({effect_id: start_values(effect_id)}, baseline, prior, tuple(load_recordings([train])),
                               tuple(held), tuple(base_errors), split, res, 2 * settings.candidate_iterations,
                               EXPLORE))

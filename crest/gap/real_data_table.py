@@ -13,7 +13,7 @@ the other (two-fold cross-validation over files), so every file gets a held-out 
                         is `none` or `unexplained`).
 
 The held-out RMSE is taken on every evaluated row of the file. The verdict's effect was selected on
-one half of the held-out fold (`model.gap.holdout_split`), so the Dahl + verdict figure
+the even time blocks of the held-out fold (`model.gap.holdout_split`), so the Dahl + verdict figure
 of a file includes the rows the selection saw; the diagnosis' own shrink is on the other half.
 """
 from __future__ import annotations

@@ -119,7 +119,7 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
                               on_fit=lambda done, total: say(f"baseline: {done}/{total} starts fitted"))
     held = res.prepare(holdout)
     base_errors = _holdout_errors(baseline, held, res)
-    split = split_holdout(held)
+    split = split_holdout([len(e) for e in base_errors])
     noise = tracker_noise_mm(list(train) + list(holdout))
     fit_rows = res.prepare_training(train)          # the training rows the fits see
     reference = calibrate_constant_curvature(fit_rows, prior)   # what Dahl must beat

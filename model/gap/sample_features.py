@@ -53,11 +53,14 @@ def compute_features(recordings: Sequence[Recording], zero_offsets_mm: Sequence[
     [T, 4] is None where every force was measured."""
     parts = []
     for index, (r, model_tension) in enumerate(zip(recordings, modelled_tension_n)):
+        u = r.tendon_mm - np.asarray(zero_offsets_mm)
         bend = bend_deg(r, zero_offsets_mm)
         theta_deg = np.hypot(bend[:, 0], bend[:, 1])
         plane_deg = np.mod(np.degrees(np.arctan2(bend[:, 1], bend[:, 0])), 360.0)
-        speed = tendon_speed_mm_s(r)
-        motion = motion_labels(r, zero_offsets_mm)
+        speed = np.max(np.abs(np.gradient(u, r.t_s, axis=0)), axis=1)
+        insertion_rate = np.abs(np.gradient(r.insertion_mm, r.t_s))
+        theta_rate = np.gradient(theta_deg, r.t_s)
+        motion = _motion(bend, theta_rate, speed, insertion_rate, r.t_s)
         force = r.tendon_force_n if model_tension is None else (
             model_tension if r.tendon_force_n is None
             else np.where(np.isfinite(r.tendon_force_n), r.tendon_force_n, model_tension))  # unmeasured: the model's
@@ -67,19 +70,6 @@ def compute_features(recordings: Sequence[Recording], zero_offsets_mm: Sequence[
         parts.append((theta_deg[valid], plane_deg[valid], r.insertion_mm[valid], motion[valid], speed[valid],
                       tension[valid], fraction[valid], np.full(int(valid.sum()), index)))
     return SampleFeatures(*(np.concatenate(columns) for columns in zip(*parts)))
-
-
-def tendon_speed_mm_s(recording: Recording) -> np.ndarray:
-    """[T] the fastest tendon's speed max_k |du_k/dt| [mm/s] (central differences)."""
-    return np.max(np.abs(np.gradient(recording.tendon_mm, recording.t_s, axis=0)), axis=1)
-
-
-def motion_labels(recording: Recording, zero_offsets_mm: Sequence[float]) -> np.ndarray:
-    """[T] the motion class of every row (module doc), with the tendon zeros `zero_offsets_mm`."""
-    bend = bend_deg(recording, zero_offsets_mm)
-    theta_rate = np.gradient(np.hypot(bend[:, 0], bend[:, 1]), recording.t_s)
-    insertion_rate = np.abs(np.gradient(recording.insertion_mm, recording.t_s))
-    return _motion(bend, theta_rate, tendon_speed_mm_s(recording), insertion_rate, recording.t_s)
 
 
 def bend_deg(recording: Recording, zero_offsets_mm: Sequence[float]) -> np.ndarray:

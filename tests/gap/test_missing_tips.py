@@ -33,7 +33,7 @@ def test_half_the_tip_cells_empty(tmp_path):
     fit = ModelFit(params, (0.0, 0.0, 0.0, 0.0), {})
     errors = tip_errors(fit, held, resolution)
     assert len(errors[0]) == held[0].valid.sum() and np.isfinite(errors[0]).all()
-    split = split_holdout(held)
+    split = split_holdout([len(e) for e in errors])
     assert np.isfinite(rmse_mm(split.selected(errors))) and np.isfinite(rmse_mm(split.reported(errors)))
     features = compute_features(held, fit.zero_offsets_mm, [None])
     tips = [predict_tips(params, fit.terms(), np.zeros(4), held[0], resolution)]

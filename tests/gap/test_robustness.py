@@ -9,7 +9,7 @@ from crest.cli.gap_command import _write_json
 from model.gap.calibration import ModelFit
 from model.gap.candidates import evaluate, ranked
 from model.gap.finite_json import finite_tree
-from model.gap.holdout_split import split_by_motion
+from model.gap.holdout_split import split_holdout
 from model import CatheterParams
 
 
@@ -20,7 +20,7 @@ def fit(effects):
 def test_a_failed_prediction_scores_last_and_is_marked_failed():
     rng = np.random.default_rng(0)
     baseline = [rng.normal(0.0, 1.0, (200, 3))]
-    split = split_by_motion([np.full(200, "static")])
+    split = split_holdout([200])
     better = evaluate(("gravity",), fit({"gravity": (0.0, -9.81)}), [0.5 * baseline[0]], baseline, split)
     diverged_errors = baseline[0].copy()
     diverged_errors[150:] = np.inf        # the model diverged on the report half only
