@@ -12,8 +12,8 @@ A one-sided effect is probed in octaves of its typical value down to 1/16 of it,
 since the effects a catheter has span decades (the blind benchmark draws them log-uniformly from
 about 1/20 of the typical value). Probed only at 1/4, 1/2 and 1, a small effect started from 'off'
 and its fit stalled there: dahl seed 91's creep of 0.13 of the typical compliance removed nothing
-(oracle 0.56 of the report half's error); started from the probe at 1/8 it removed 0.50 of the
-selection half's.
+(oracle 0.56 of the report half's error); probed down to 1/16 it removed 0.50 of the selection
+half's.
 """
 from __future__ import annotations
 

@@ -3,7 +3,7 @@
 The blind benchmark draws effect sizes log-uniformly from about 1/20 of the catalog's typical value
 (`crest/gap/effect_draws.py`). A fit started at 'off' or at a quarter of the typical value can stall
 short of a small effect: dahl seed 91's rate lag of 0.13 of the typical creep compliance fitted to
-nothing from there, and to 0.50 of the selection half's error from the probe at 1/8."""
+nothing from there, and to 0.50 of the selection half's error once probed down to 1/16."""
 import numpy as np
 
 from crest.gap.effect_draws import DAHL_EFFECT_RANGES
