@@ -29,7 +29,7 @@ def test_a_one_sided_effect_is_probed_in_octaves_down_to_the_smallest_draws():
         assert sizes[0] <= 2.0 * lowest_draw, f"{effect_id}: smallest probe {sizes[0]:g}, draws from {lowest_draw:g}"
 
 
-def test_a_small_creep_starts_its_fit_at_the_probe_nearest_its_size(tmp_path):
+def test_a_small_creep_starts_its_fit_at_a_probe_next_to_its_size(tmp_path):
     typical_compliance, typical_time = EFFECTS["rate_lag"].typical
     truth = (typical_compliance / 12, typical_time)
     train, _ = record_case(tmp_path, {"rate_lag": truth})
