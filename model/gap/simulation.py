@@ -166,9 +166,9 @@ def _run(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarr
          resolution: Resolution, iteration_limit: int | None = None) -> tuple[np.ndarray, np.ndarray, int]:
     """Tips [T, 3], drive tensions [T, 4] and the Newton iterations they took (see `predict_tips`).
 
-    The last RUN_MEMORY runs of this process are remembered by their exact inputs (parameters and
-    effects by repr, which tells -0.0 from 0.0; zero offsets and the recording's inputs by their
-    bytes). A fit asks for the same run again where it continues from a point it has fitted before:
+    The latest runs of this process (up to RUN_MEMORY_BYTES) are remembered by their exact inputs
+    (parameters and effects by repr, which tells -0.0 from 0.0; zero offsets and the recording's
+    inputs by their bytes). A fit asks for the same run again where it continues from a point it has fitted before:
     a restart or a final fit re-evaluates the cost and the finite-difference Jacobian at the point
     the previous least-squares run ended on, and every fit first measures the solver work of its
     start (`calibration.iteration_limit`) and then evaluates the cost there. The model is
@@ -182,7 +182,6 @@ def _run(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarr
     limit = math.inf if iteration_limit is None else iteration_limit
     known = _RUNS.get(key)
     if known is not None:
-        _RUNS.move_to_end(key)
         if known.diverged:
             raise ModelSolverError(f"the catheter model diverged (non-finite state) with {params}")
         if known.tips is not None and known.iterations <= limit:
@@ -194,16 +193,21 @@ def _run(params: CatheterParams, effects: EffectTerms, zero_offsets_mm: np.ndarr
         tips, tension = model.run_with_tension(recording.tendon_mm - zero_offsets_mm, recording.insertion_mm,
                                                recording.sample_period_s, limit)
     except SolverBudgetExceeded:
-        _remember(key, _Outcome(None, None, limit, False))
+        _RUNS.remember(key, _Outcome(None, None, limit, False))
         raise
     except ModelSolverError:
-        _remember(key, _Outcome(None, None, 0, True))
+        _RUNS.remember(key, _Outcome(None, None, 0, True))
         raise
-    _remember(key, _Outcome(tips.copy(), tension.copy(), model.solver_iterations[0], False))
+    _RUNS.remember(key, _Outcome(tips.copy(), tension.copy(), model.solver_iterations[0], False))
     return tips, tension, model.solver_iterations[0]
 
 
-RUN_MEMORY = 96   # runs remembered per process: a Jacobian and its point take 1 + n runs per recording
+# Runs remembered per process, by the bytes of their tips and tensions (7 numbers a sample: about 27 kB a
+# run of a test's training log, 53 kB of the blind benchmark's). A fit's restarts and final fits return
+# to points fitted a few hundred runs before: a test diagnosis (`tests.gap.conftest`, backlash, one
+# worker) made 4796 model runs with the 96 runs remembered until 2026-12-07, 4410 with 64 MB, and gave
+# the same result.
+RUN_MEMORY_BYTES = 64 * 2 ** 20
 
 
 @dataclass(frozen=True)
@@ -217,14 +221,35 @@ class _Outcome:
     diverged: bool
 
 
-_RUNS: OrderedDict[tuple, _Outcome] = OrderedDict()
+class _RunMemory:
+    """The remembered runs, least recently used first, within RUN_MEMORY_BYTES (a run's tips and
+    tensions, and KEY_BYTES for its key, so that failed runs count too)."""
+
+    KEY_BYTES = 1024
+
+    def __init__(self):
+        self.runs: OrderedDict[tuple, _Outcome] = OrderedDict()
+        self.nbytes = 0
+
+    def get(self, key: tuple) -> _Outcome | None:
+        known = self.runs.get(key)
+        if known is not None:
+            self.runs.move_to_end(key)
+        return known
+
+    def remember(self, key: tuple, outcome: _Outcome) -> None:
+        old = self.runs.pop(key, None)
+        self.nbytes += self._size(outcome) - (self._size(old) if old else 0)
+        self.runs[key] = outcome
+        while self.nbytes > RUN_MEMORY_BYTES and len(self.runs) > 1:
+            self.nbytes -= self._size(self.runs.popitem(last=False)[1])
+
+    def _size(self, outcome: _Outcome) -> int:
+        arrays = 0 if outcome.tips is None else outcome.tips.nbytes + outcome.tension.nbytes
+        return self.KEY_BYTES + arrays
 
 
-def _remember(key: tuple, outcome: _Outcome) -> None:
-    _RUNS[key] = outcome
-    _RUNS.move_to_end(key)
-    while len(_RUNS) > RUN_MEMORY:
-        _RUNS.popitem(last=False)
+_RUNS = _RunMemory()
 
 
 def _model(params: CatheterParams, effects: EffectTerms, recording: Recording,

@@ -1,6 +1,6 @@
 """A fit gives up on parameters where the solver crawls by counting Newton iterations (issue 17): the
 limit bounds the runs along all the recordings together, not each recording's run, and a remembered
-run obeys the limit it is asked for like a fresh one."""
+run obeys the limit it is asked for like a fresh one. The remembered runs stay within their bytes."""
 import math
 
 import numpy as np
@@ -10,6 +10,7 @@ from model import CatheterParams, SolverBudgetExceeded
 from model.gap.calibration import MIN_ITERATION_LIMIT, ModelFit, tip_errors
 from model.gap.candidates import holdout_iteration_limit
 from model.gap.recording import Recording
+from model.gap import simulation
 from model.gap.simulation import Resolution, catheter_for, predict_run
 
 RESOLUTION = Resolution(n_elements=6)
@@ -60,3 +61,24 @@ def test_a_held_out_run_may_take_what_the_start_or_the_fit_itself_took_per_train
     assert holdout_iteration_limit(2000, 6000, train, holdout) == 9000
     assert holdout_iteration_limit(6000, 2000, train, holdout) == 9000
     assert holdout_iteration_limit(10, 20, train, holdout) == MIN_ITERATION_LIMIT
+
+
+def test_the_remembered_runs_stay_within_their_bytes_forgetting_the_least_recently_used(monkeypatch):
+    run_bytes = 20 * 7 * 8 + simulation._RunMemory.KEY_BYTES    # 20 samples of tips (3) and tensions (4)
+    monkeypatch.setattr(simulation, "RUN_MEMORY_BYTES", 3 * run_bytes)
+    memory = simulation._RunMemory()
+
+    def run(iterations):
+        return simulation._Outcome(np.zeros((20, 3)), np.zeros((20, 4)), iterations, False)
+
+    for key in "abc":
+        memory.remember(key, run(1))
+    assert memory.get("a") is not None            # now the most recently used
+    memory.remember("d", run(2))
+    assert memory.get("b") is None and all(memory.get(key) is not None for key in "acd")
+    memory.remember("d", run(3))                  # the same key again replaces, not adds
+    assert memory.nbytes == 3 * run_bytes and memory.get("d").iterations == 3
+    failed = simulation._Outcome(None, None, 10, False)
+    for key in range(100):                        # failed runs have no tips, but count too
+        memory.remember(key, failed)
+    assert memory.nbytes <= 3 * run_bytes and len(memory.runs) == 3 * run_bytes // simulation._RunMemory.KEY_BYTES
