@@ -124,12 +124,12 @@ def _element_modifiers(n, length, params, effects, point_loads, tension, points,
         rest_bend[i, 1] = effects[E_KAPPA0_Y] * h
         ext_bend[i, 0] = 0.0
         ext_bend[i, 1] = 0.0
-    if not loads_act(params, effects, point_loads):
-        return
     weight = params[P_RHO] * h
     f0 = weight * effects[E_GX]
     f1 = weight * effects[E_GY]
     f2 = weight * effects[E_GZ]
+    if f0 == 0.0 and f1 == 0.0 and f2 == 0.0 and point_loads.shape[0] == 0:
+        return
     sum_f = np.zeros(3)      # total load distal to the current element's base
     sum_pxf = np.zeros(3)    # and its moment about the origin
     for i in range(n - 1, -1, -1):
@@ -155,15 +155,6 @@ def _element_modifiers(n, length, params, effects, point_loads, tension, points,
         local_y = frames[i, 0, 1] * m0 + frames[i, 1, 1] * m1 + frames[i, 2, 1] * m2
         ext_bend[i, 0] = local_y / kb
         ext_bend[i, 1] = -local_x / kb
-
-
-@kernel
-def loads_act(params, effects, point_loads) -> bool:
-    """Whether external loads act: the element weights (the gravity effect on a catheter with mass)
-    or point loads. Only then does a step need the shape of the step before it (`_element_modifiers`)."""
-    weight = params[P_RHO]
-    return (weight * effects[E_GX] != 0.0 or weight * effects[E_GY] != 0.0 or weight * effects[E_GZ] != 0.0
-            or point_loads.shape[0] > 0)
 
 
 @kernel
@@ -455,28 +446,27 @@ def dynamic_bend_offset(length, kb, dt_s, params, rest_bend, ext_bend, bend, ben
 
 @kernel
 def make_workspace(n):
-    """Scratch arrays for quasi_static_step, allocated once per run. The last two, the element lengths
-    of the last step taken and whether `points` and `frames` lag behind it, are read by run_path too."""
+    """Scratch arrays for quasi_static_step, allocated once per run."""
     return (np.empty(n), np.empty(n), np.empty((n, 2)), np.empty((n, 2)), np.empty((n, 4)), np.empty((n, 4)),
             np.empty((4, n)), np.empty((4, n)), np.empty((4, n)), np.empty((4, n)), np.empty((n, 2)),
             np.empty((4, n)), np.empty((4, n)), np.empty((n, 4, 5)), np.empty(4), np.empty(4),
             np.empty((4, 5)), np.empty((4, 5)), np.empty((4, n)), np.empty((4, n)),
             np.empty((4, n)), np.empty((n, 2)), np.empty(n), np.empty((4, n)), np.empty(4),
-            np.zeros(4, dtype=np.bool_), np.zeros((4, n), dtype=np.bool_), np.zeros((4, n), dtype=np.bool_),
+            np.zeros(4, dtype=np.bool_), np.empty(n), np.zeros((4, n), dtype=np.bool_), np.zeros((4, n), dtype=np.bool_),
             np.empty(4),
             np.zeros((4, n), dtype=np.bool_), np.zeros(4, dtype=np.bool_),
             (np.empty(4), np.empty(4), np.empty((4, 5)), np.empty((4, 5)), np.empty((4, 5)), np.empty(5), np.empty(4),
              np.empty(4)),
             (np.empty((4, 5)), np.zeros(4, dtype=np.bool_), np.zeros(4, dtype=np.bool_), np.empty((4, 4)),
              np.empty((4, 1)), np.empty(4, dtype=np.int64)),
-            np.empty((n, 2)), np.empty(4), np.empty((4, n)), np.empty(n), np.zeros(1, dtype=np.bool_))
+            np.empty((n, 2)), np.empty(4), np.empty((4, n)))
 
 
 @kernel
 def quasi_static_step(u, length, rate_scale, params, effects, point_loads, friction, sliding, last_step, tension,
                       last_tension_step, bend, compression, tip_tension, drive_tension, slack, points, frames,
                       scalars, work, max_iterations, commit_unconverged, dt_s, bend_rate, creep, extrapolate,
-                      refine_tightening, compose):
+                      refine_tightening):
     """Advance the catheter state to equilibrium at tendon input u [mm] and free length [mm].
 
     In the dynamic mode (damping time or inertia scale > 0, see `has_dynamics`) the step is one
@@ -487,8 +477,6 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
     extrapolate: start Newton from the last step's tension trend (see below; False on a retry).
     refine_tightening: a converged step in which a slack tendon tightens is not taken (False is
     returned, for the caller to retry it in halves; see run_path).
-    compose: chain the new shape into `points` and `frames` (`compose_backbone`); without it the
-    step marks them stale (`shape_stale` of the workspace) for the caller to chain once it needs them.
 
     `rate_scale[k]` multiplies tendon k's friction strength (rate friction, 1 without it).
     `work` is scratch space from make_workspace. Returns
@@ -506,8 +494,8 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
 
     (arm, angle, rest_bend, ext_bend, cos_phi, sin_phi, f0, kx, gt, gth, bend_dir, xref, tref, lin_force,
      distal_force, distal_short, dist_force, dist_short, new_force, new_sliding, new_tension,
-     new_bend, new_compression, increment, linear_force, revived, clamped, released, previous_increment,
-     crossed, slack_before, sweep_scratch, tip_scratch, dynamic_offset, u_step, strength, lengths, shape_stale) = work
+     new_bend, new_compression, increment, linear_force, revived, lengths, clamped, released, previous_increment,
+     crossed, slack_before, sweep_scratch, tip_scratch, dynamic_offset, u_step, strength) = work
     compliance, carry = drive_creep(effects, dt_s)
     for k in range(4):
         u_step[k] = u[k] - carry * creep[k]
@@ -719,9 +707,7 @@ def quasi_static_step(u, length, rate_scale, params, effects, point_loads, frict
         bend[i, 1] = new_bend[i, 1]
         compression[i] = new_compression[i]
         lengths[i] = h - new_compression[i]
-    if compose:
-        compose_backbone(bend, lengths, points, frames)
-    shape_stale[0] = not compose
+    compose_backbone(bend, lengths, points, frames)
     return True
 
 
@@ -826,11 +812,6 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
     work = make_workspace(bend.shape[0])
     dynamic = has_dynamics(params)
     stop_at_iterations = scalars[S_ITERATIONS] + iteration_budget
-    # Only the tip after each sample is read, unless loads act: then each step's loads need the shape
-    # of the step before, and every step chains it. Chained only after each sample, a run of a test
-    # diagnosis's training log (6 elements, 478 samples) gave the same tips to the bit, about 6 % sooner.
-    shape_each_step = loads_act(params, effects, point_loads)
-    lengths, shape_stale = work[-2], work[-1]
     for t in range(n_samples):
         for k in range(4):
             target[k] = play_operator(applied_tendon_mm[k], tendon_mm[t, k], effects[E_BACKLASH])
@@ -865,7 +846,7 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
                                  last_step, tension, last_tension_step, bend, compression, tip_tension,
                                  drive_tension, slack, points, frames, scalars, work, max_iterations,
                                  fraction <= smallest, fraction * dt_s, bend_rate, creep, not retry,
-                                 fraction > tightening_smallest, shape_each_step):
+                                 fraction > tightening_smallest):
                 done = w
                 fraction = min(2.0 * fraction, 1.0 / n_sub)
                 retry = False
@@ -877,9 +858,6 @@ def run_path(tendon_mm, insertion_mm, dt_s, max_tendon_step_mm, max_insertion_st
         for k in range(4):
             applied_tendon_mm[k] = target[k]
         applied_insertion_mm[0] = length_target
-        if shape_stale[0]:
-            compose_backbone(bend, lengths, points, frames)
-            shape_stale[0] = False
         nb = points.shape[0] - 1
         for a in range(3):      # as the tracker sees it: p_tip + R_tip d + o
             tips_out[t, a] = points[nb, a] + (frames[nb, a, 0] * effects[E_SENSOR_X]
