@@ -174,6 +174,8 @@ def format_verdict(result: dict) -> str:
              f"(selected on the other half: {verdict['shrink_estimate']['method']})"]
     if verdict["confidence_line"]:
         lines.append(verdict["confidence_line"])
+    for row in verdict.get("as_good", []):
+        lines.append(f"as good on these logs: {row['effect']}: {row['reason']}")
     if verdict["model_form_rms_mm"] is not None and not verdict["effects"]:
         lines.append(f"residual above the noise floor (model form): {verdict['model_form_rms_mm']:.3f} mm RMS")
     for row in verdict["rejected"]:

@@ -120,6 +120,7 @@ def markdown(result: dict) -> str:
         lines.append(f"- {effect_id}: " + ", ".join(f"{k} = {v:.4g}" for k, v in params.items()))
     lines += [f"- named before {row['effect']}, which scored higher: {row['reason']}"
               for row in verdict.get("simpler_than", [])]
+    lines += [f"- as good on these logs: {row['effect']}: {row['reason']}" for row in verdict.get("as_good", [])]
     lines += ["", "Held-out tip RMSE per recording (all evaluated rows), against calibrated constant curvature:", "",
               "| recording | calibrated CC | calibrated Dahl | Dahl + verdict |", "|---|---|---|---|"]
     lines += [f"| {row['recording']} | {row['constant_curvature_mm']:.3f} mm | {row['baseline_mm']:.3f} mm | "

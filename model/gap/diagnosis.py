@@ -49,7 +49,7 @@ from model.gap.regions import breakdown, concentrated, regions, shrink_by_region
 from model.gap.sample_features import SampleFeatures, compute_features
 from model.gap.significance import is_meaningful, is_significant_residual, model_form_rms_mm, nothing_to_explain
 from model.gap.signatures import describe, signatures
-from model.gap.simplest_effect import parameter_count, simplest_sufficient
+from model.gap.simplest_effect import as_good_as, parameter_count, simplest_sufficient
 from model.gap.simulation import Resolution, predict_tips, predict_tips_and_tension
 from model.gap.starting_points import start_values
 from model.gap.verdict_confidence import confidence, confidence_line
@@ -94,7 +94,8 @@ def diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: Ca
     "effect" (best id or "none"), "effects" (all selected), "holdout_rmse_before_mm",
     "holdout_rmse_after_mm", "shrink" (0..1) and "confidence" (`verdict_confidence`: "confident" where the
     named effects at least halve the report half's error above the noise floor, "partial" below, None
-    when nothing is named) with its "confidence_line"; "sampling" says which rows of the logs the fits and
+    when nothing is named) with its "confidence_line", and "as_good" (the found effects the named one does
+    not beat by more than noise and fitting freedom explain, `simplest_effect.as_good_as`); "sampling" says which rows of the logs the fits and
     the held-out evaluation used (`Resolution.sampling`: decimation, the training cap).
     """
     if not train or not holdout:
@@ -237,6 +238,12 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
         pairs = ranked(pairs)
         if pairs and not rejections(pairs[0], best):
             chosen.append(pairs[0])
+    listed = {row["effect"] for row in simpler_than} | set(chosen[-1].effects if chosen else ())
+    as_good = [{"effect": r.effects[0], "selection_rmse_mm": r.holdout_rmse_mm,
+                "reason": f"{chosen[0].effects[0]} removes no more error than noise and fitting freedom explain "
+                          f"beyond it ({r.holdout_rmse_mm:.3f} -> {chosen[0].holdout_rmse_mm:.3f} mm on the selection "
+                          "half), so these logs cannot tell them apart"}
+               for r in (as_good_as(chosen[0], eligible, noise) if chosen else []) if r.effects[0] not in listed]
     timing["pairs"] = time.perf_counter() - clock - sum(timing.values())
 
     say("where: residual by region and signatures")
@@ -278,6 +285,7 @@ def _diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: C
         "residual_concentrated": [row["region"] for row in concentrated(after_where)],
         "model_form_rms_mm": model_form_rms_mm(after_rmse, noise),
         "simpler_than": simpler_than if final else [],
+        "as_good": as_good,
         "rejected": [] if final else [{"effect": r.effects[0], "reasons": rejections(r)} for r in singles[:3]],
         "fit": after_fit.as_dict(),
     }

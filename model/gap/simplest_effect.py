@@ -17,6 +17,12 @@ the best's removes no more than noise and fitting freedom explain (`significance
 the selection half), are sufficient, and the simplest of them leads (the fewest parameters, then the
 lowest error). A richer effect that removes meaningfully more keeps its verdict: on dahl seed 53,
 case 4, a true lag (tau 0.137 s) removed 0.537 of the error against the elastic line's 0.183.
+
+The other found effects that the named one does not beat by more than noise and fitting freedom
+explain are as good on these logs (`as_good_as`): the verdict lists them beside it, since the logs
+cannot tell them apart. The two rigid offsets are such twins where the tip barely
+turns: on rod seed 112 a tracker offset was named `sensor_offset` (1.062 mm on the selection half
+against the tracker offset's 1.078 mm, from 1.837 mm) and a sensor offset `tracker_offset`.
 """
 from __future__ import annotations
 
@@ -45,3 +51,11 @@ def simplest_sufficient(eligible: Sequence[CandidateResult], noise_mm: float | N
         return ranked
     simplest = min(sufficient, key=lambda r: (parameter_count(r), r.holdout_rmse_mm))
     return [simplest] + [r for r in ranked if r is not simplest]
+
+
+def as_good_as(named: CandidateResult, found: Sequence[CandidateResult],
+               noise_mm: float | None) -> list[CandidateResult]:
+    """The effects of `found` (other than `named`) that `named` does not beat on the selection half by
+    more than noise and fitting freedom explain (`significance.is_meaningful`), best first."""
+    return [r for r in found if r.effects != named.effects
+            and not is_meaningful(r.holdout_rmse_mm, named.holdout_rmse_mm, noise_mm)]
