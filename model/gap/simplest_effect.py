@@ -21,8 +21,8 @@ case 4, a true lag (tau 0.137 s) removed 0.537 of the error against the elastic 
 The other found effects that the named one does not beat by more than noise and fitting freedom
 explain are as good on these logs (`as_good_as`): the verdict lists them beside it, since the logs
 cannot tell them apart. The two rigid offsets are such twins where the tip barely
-turns: on rod seed 112 a tracker offset was named `sensor_offset` (1.062 mm on the selection half
-against the tracker offset's 1.078 mm, from 1.837 mm) and a sensor offset `tracker_offset`.
+turns: on rod seed 112 a tracker offset was named `sensor_offset` (1.061 mm on the selection half
+against the tracker offset's 1.079 mm, from 1.837 mm) and a sensor offset `tracker_offset`.
 """
 from __future__ import annotations
 
