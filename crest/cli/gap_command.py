@@ -234,6 +234,9 @@ def format_family_score(family: str, score: dict) -> str:
     if any(misses[cause] for cause in CAUSES):
         lines.append("misses above the detection limit, by cause: "
                      + "; ".join(f"{misses[cause]} {CAUSE_WORDS[cause]}" for cause in CAUSES if misses[cause]))
+        if misses.get("truth_as_good"):
+            lines.append(f"misses whose verdict listed the true effect as good on these logs (a tie): "
+                         f"{misses['truth_as_good']}")
     for kind, key in (("a clean", "largest_candidate_shrink_clean"),
                       ("an out-of-catalog", "largest_candidate_shrink_out_of_catalog")):
         if score.get(key) is not None:

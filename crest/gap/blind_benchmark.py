@@ -387,6 +387,7 @@ def run_case(case: BlindCase, folder: Path, config: TestbedConfig, plan: Excitat
            "baseline_holdout_rmse_mm": result["baseline"]["holdout_rmse_mm"],
            "model_form_rms_mm": verdict["model_form_rms_mm"], "predicted_shrink": verdict["shrink"],
            "predicted_confidence": verdict["confidence"],
+           "as_good": [alternative["effect"] for alternative in verdict["as_good"]],
            "top_candidates": [c["effect"] for c in result["candidates"][:3]],
            "candidates": [candidate_summary(c) for c in result["candidates"]],
            "record_seconds": recorded - start, "seconds": seconds, "timing_s": result["timing_s"],

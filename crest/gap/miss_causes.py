@@ -18,6 +18,11 @@ name its true effect is put down to the first of these that holds:
   nothing (or the diagnosis gave no result): the diagnosis's own miss, the one its rules can mend.
 
 A case whose oracle failed or was never computed gets `no_oracle`.
+
+Apart from its cause, a miss whose verdict listed the true effect as good on these logs (the
+verdict's `as_good`, kept in the case row since ff8ba06) is a tie the logs cannot break: the
+diagnosis found the truth and could not tell it from the effect it named. `miss_causes` counts them
+as `truth_as_good`.
 """
 from __future__ import annotations
 
@@ -51,10 +56,12 @@ def miss_cause(row: dict) -> str:
 
 
 def miss_causes(missed: list[dict]) -> dict:
-    """{cause: count} over every cause, and "by_effect": {true effect: {cause: count}} over the causes met."""
+    """{cause: count} over every cause, "by_effect": {true effect: {cause: count}} over the causes met, and
+    "truth_as_good": the misses whose verdict listed the true effect as good (see module doc)."""
     causes = [(row["truth"][0], miss_cause(row)) for row in missed]
     by_effect: dict[str, dict[str, int]] = {}
     for effect_id, cause in sorted(causes):
         by_effect.setdefault(effect_id, {})
         by_effect[effect_id][cause] = by_effect[effect_id].get(cause, 0) + 1
-    return {**{cause: sum(c == cause for _, c in causes) for cause in CAUSES}, "by_effect": by_effect}
+    return {**{cause: sum(c == cause for _, c in causes) for cause in CAUSES}, "by_effect": by_effect,
+            "truth_as_good": sum(row["truth"][0] in row.get("as_good", []) for row in missed)}

@@ -148,6 +148,9 @@ def _miss_rows(misses: dict) -> list[str]:
     for effect_id, causes in misses["by_effect"].items():
         lines.append(f"| {effect_id} | " + " | ".join(str(causes.get(cause, 0)) for cause in CAUSES) + " |")
     lines.append("| all effects | " + " | ".join(str(misses[cause]) for cause in CAUSES) + " |")
+    if misses.get("truth_as_good"):
+        lines += ["", f"In {misses['truth_as_good']} of these misses the verdict listed the true effect as good "
+                      "on these logs: a tie the logs cannot break."]
     return lines + [""]
 
 

@@ -1,8 +1,10 @@
 """Blind benchmark bookkeeping (issue 6, blind validation): the draw and the scores."""
 import pytest
 
+from crest.cli.gap_command import format_family_score
 from crest.gap.blind_benchmark import ALL_EFFECTS, draw_cases, score
 from crest.gap.miss_causes import ABSORBED, CAUSES, DIAGNOSIS, NO_ORACLE, ORACLE_NOT_SIGNIFICANT, miss_cause
+from crest.reports.blind_report import markdown
 from model import CatheterParams
 from model.effects import EFFECTS
 
@@ -175,3 +177,19 @@ def test_a_miss_above_the_limit_is_put_down_to_absorption_to_the_fitted_truth_or
                                    "gravity": {ABSORBED: 1, DIAGNOSIS: 1},
                                    "lumen_compression": {ORACLE_NOT_SIGNIFICANT: 1}}
     assert miss_cause({**missed("backlash", 0.4), "no_result": "timed out"}) == DIAGNOSIS
+
+
+def test_a_miss_whose_verdict_listed_the_truth_as_good_is_counted_as_a_tie():
+    """Rod seed 112, case 2: a tracker offset named `sensor_offset`, the tracker offset listed as good."""
+    tie = {**row("single", ["tracker_offset"], "sensor_offset"), "above_detection_limit": True, "oracle_shrink": 0.4,
+           "as_good": ["tracker_offset"]}
+    other = {**row("single", ["gravity"], "precurvature"), "above_detection_limit": True, "oracle_shrink": 0.4,
+             "as_good": ["tube_friction"]}
+    stored = {**row("single", ["backlash"], "unexplained"), "above_detection_limit": True, "oracle_shrink": 0.4}
+    scored = score([tie, other, stored])
+    misses = scored["misses_above_detection"]
+    assert misses[DIAGNOSIS] == 3 and misses["truth_as_good"] == 1
+    line = "misses whose verdict listed the true effect as good on these logs (a tie): 1"
+    assert line in format_family_score("rod", scored).splitlines()
+    report = markdown({"combined": ["rod seed 112"], "score": {"rod": scored}, "cases": []})
+    assert "In 1 of these misses the verdict listed the true effect as good on these logs" in report
