@@ -15,15 +15,21 @@ Two checks, each giving a reason when it fails (a fit that passes both has no re
    describes: on the rod plant, a stiffness step (out of catalog) was named lumen_compression with
    extents of 3.5-4.2 mm on three seeds at 12.5 mm elements, while every lumen compression the
    Dahl family's seeds named had 15-34 mm. Nor may it push a lumen more than half way to the
-   neutral axis: at the base the moment arm is r / (1 + c sum_k T_k) (model.quasi_static_kernel),
-   so with the largest summed drive tension the training logs measured, T_max, the squeeze
-   X = c T_max may reach MAX_LUMEN_SQUEEZE = 1 (the arm at half the lumen offset), no more. A wall
+   neutral axis: element i's moment arm is r / (1 + c sum_k T_ki exp(-s_i / extent)) at its centre
+   s_i = (i + 1/2) h (model.quasi_static_kernel), most squeezed in the first element, so with the
+   largest summed drive tension the training logs measured, T_max, the squeeze
+   X = c T_max exp(-h / (2 extent)) may reach MAX_LUMEN_SQUEEZE = 1 (the arm at half the lumen
+   offset), no more (without the element length h: X = c T_max, the continuous arm at the base). A wall
    that gives that far under a few newtons is no longer a lumen displaced by its load but a
    different catheter: a softer one, or one with its curvature elsewhere (model form). On the rod
    plant, whose own lumen compression shortens the arm to r^2 / (r + c_rod T) (0.53 r at its
    drawing range's top, 0.1 mm/N, at 20 N with its r = 2.3 mm), the stiffness steps (out of
-   catalog) named lumen_compression on seeds 91, 96 and 98 needed X = 1.5, 2.4 and 1.9, the true
-   lumen compression seed 98 named X = 0.82. A
+   catalog) named lumen_compression on seeds 91, 96 and 98 needed c T_max = 1.5, 2.4 and 1.9, the
+   true lumen compression seed 98 named 0.82. Until 2026-12-07 the rule took c T_max, the arm at the
+   base, where the model has no element: at 12.5 mm elements the fits of five true rod lumen
+   compressions (seeds 104, 106, 111 twice, 113; extents 6.5-9.3 mm) had c T_max of 1.04-3.1 and were
+   rejected, but at the first element's centre four of them squeeze 0.50-0.92 (seed 106's 1.19); so do
+   two of the three stiffness steps rejected on fresh seeds (101, 102: 0.68, 0.96; 103: 1.35). A
    rate lag must be resolvable at the fits' sampling: its time constant at least
    MIN_LAG_SAMPLES of a (decimated) sample period. A lag shorter than that moves each sample by
    less than it moves between samples; with tau -> 0 the creep s + tau ds/dt = c T is the
@@ -143,6 +149,8 @@ The signature regions (the catalog's `signature_region`):
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from model.effects.catalog import effect
@@ -201,6 +209,15 @@ def _region_masks(f: SampleFeatures) -> dict:
     }
 
 
+def lumen_squeeze(values: tuple[float, ...], max_summed_tension_n: float, element_length_mm: float | None) -> float:
+    """X = c T_max exp(-h / (2 extent)) of a lumen compression (c, extent) = values: how far the first
+    element's lumen is pushed toward the neutral axis at the largest summed drive tension (module doc);
+    c T_max, the continuous arm at the base, without the element length h."""
+    coef_per_n, extent_mm = values
+    reach = 1.0 if element_length_mm is None else math.exp(-element_length_mm / (2.0 * extent_mm))
+    return coef_per_n * max_summed_tension_n * reach
+
+
 def range_reasons(effect_id: str, values: tuple[float, ...], flexible_length_mm: float | None = None,
                   sample_period_s: float | None = None, element_length_mm: float | None = None,
                   max_summed_tension_n: float | None = None, longest_hold_s: float | None = None) -> list[str]:
@@ -211,12 +228,14 @@ def range_reasons(effect_id: str, values: tuple[float, ...], flexible_length_mm:
     (`longest_hold_s`), for the effects whose range depends on them (None: not checked)."""
     candidate = effect(effect_id)
     reasons = []
-    squeeze = values[0] * max_summed_tension_n \
+    squeeze = lumen_squeeze(values, max_summed_tension_n, element_length_mm) \
         if effect_id == "lumen_compression" and max_summed_tension_n is not None else 0.0
+    where = "at the base" if element_length_mm is None else \
+        f"at the first element's centre ({element_length_mm / 2:.3g} mm from the base)"
     if squeeze > MAX_LUMEN_SQUEEZE:
-        reasons.append(f"lumen_compression.coef_per_n = {values[0]:.3g} /N at the largest summed drive tension of the "
-                       f"training logs ({max_summed_tension_n:.3g} N) shrinks the moment arm at the base to "
-                       f"{1.0 / (1.0 + squeeze):.0%} of the lumen offset: a lumen pushed more than half way to the "
+        reasons.append(f"lumen_compression.coef_per_n = {values[0]:.3g} /N over {values[1]:.3g} mm at the largest summed "
+                       f"drive tension of the training logs ({max_summed_tension_n:.3g} N) shrinks the moment arm "
+                       f"{where} to {1.0 / (1.0 + squeeze):.0%} of the lumen offset: a lumen pushed more than half way to the "
                        "neutral axis is not a wall giving under load but another catheter (softer, or bent elsewhere)")
     if effect_id == "rate_lag" and sample_period_s is not None and values[1] < MIN_LAG_SAMPLES * sample_period_s:
         reasons.append(f"rate_lag.time_s = {values[1]:.3g} s is shorter than {MIN_LAG_SAMPLES:g} of the fits' sample "

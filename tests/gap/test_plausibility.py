@@ -1,5 +1,6 @@
 """Plausibility (issue 14, item 4): a fit that needs parameters at the limit of their physical range, or
 whose improvement does not sit where its signature says, is rejected with a reason."""
+import math
 from dataclasses import replace
 
 import numpy as np
@@ -8,7 +9,7 @@ import pytest
 from model import CatheterParams, DahlCatheter
 from model.effects import combined_terms
 from model.gap.plausibility import (LOSS_FRACTION, MIN_SIGNATURE_CONCENTRATION, hold_drift_reasons, hold_drift_rms_mm,
-                                    longest_hold_s, range_reasons, signature_reasons, static_holds)
+                                    longest_hold_s, lumen_squeeze, range_reasons, signature_reasons, static_holds)
 from model.gap.recording import Recording
 from model.gap.significance import is_meaningful
 from model.gap.sample_features import SampleFeatures
@@ -233,8 +234,8 @@ def test_lumen_compression_along_the_whole_catheter_is_not_near_the_base():
 
 
 def test_a_lumen_pushed_more_than_half_way_to_the_neutral_axis_is_implausible():
-    """The arm at the base is r / (1 + c T_max) at the largest summed drive tension T_max: c T_max = 1
-    halves it, the bound. The values are rod seed 98's: its true lumen compression (c = 0.044 /N at
+    """Without the element length, the continuous arm at the base, r / (1 + c T_max) at the largest summed
+    drive tension T_max: c T_max = 1 halves it, the bound. The values are rod seed 98's: its true lumen compression (c = 0.044 /N at
     18.6 N: the arm at 55 %) and the stiffness step named lumen_compression (0.35 /N at 5.4 N: 35 %)."""
     assert range_reasons("lumen_compression", (0.044, 7.3), max_summed_tension_n=18.6) == []
     assert range_reasons("lumen_compression", (0.05, 20.0), max_summed_tension_n=20.0) == []     # exactly half
@@ -242,6 +243,20 @@ def test_a_lumen_pushed_more_than_half_way_to_the_neutral_axis_is_implausible():
     assert len(reasons) == 1 and "35% of the lumen offset" in reasons[0] and "half way" in reasons[0]
     assert range_reasons("lumen_compression", (0.35, 16.5)) == []           # a log without tensions: not checked
     assert range_reasons("tendon_elasticity", (0.35,), max_summed_tension_n=5.4) == []
+
+
+def test_the_squeeze_is_taken_where_the_model_has_its_first_element():
+    """The model's arms sit at the element centres s_i = (i + 1/2) h: the first is squeezed by
+    c T_max exp(-h / (2 extent)). Rod seed 113, case 9, a true lumen compression: fitted at 0.0417 /N over
+    8.41 mm, 25 N of summed tension, 12.5 mm elements: 1.04 at the base, 0.50 at the first centre (the arm
+    at 67 %). Rod seed 103, case 15, a stiffness step: 0.319 /N over 9.82 mm at 8.0 N, 1.35 there."""
+    assert lumen_squeeze((0.0417, 8.41), 25.0, None) == pytest.approx(1.0425)
+    assert lumen_squeeze((0.0417, 8.41), 25.0, 12.5) == pytest.approx(1.0425 * math.exp(-6.25 / 8.41))
+    assert range_reasons("lumen_compression", (0.0417, 8.41), max_summed_tension_n=25.0, element_length_mm=12.5) == []
+    assert len(range_reasons("lumen_compression", (0.0417, 8.41), max_summed_tension_n=25.0)) == 1
+    reasons = range_reasons("lumen_compression", (0.319, 9.82), max_summed_tension_n=8.0, element_length_mm=12.5)
+    assert len(reasons) == 1 and "at the first element's centre (6.25 mm from the base) to 43% of the lumen offset" \
+        in reasons[0]
 
 
 def test_the_largest_summed_tension_counts_missing_tendons_as_slack():
