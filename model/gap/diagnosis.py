@@ -95,8 +95,9 @@ def diagnose(train: Sequence[Recording], holdout: Sequence[Recording], prior: Ca
     "holdout_rmse_after_mm", "shrink" (0..1) and "confidence" (`verdict_confidence`: "confident" where the
     named effects at least halve the report half's error above the noise floor, "partial" below, None
     when nothing is named) with its "confidence_line", and "as_good" (the found effects the named one does
-    not beat by more than noise and fitting freedom explain, `simplest_effect.as_good_as`); "sampling" says which rows of the logs the fits and
-    the held-out evaluation used (`Resolution.sampling`: decimation, the training cap).
+    not beat by more than noise and fitting freedom explain, `simplest_effect.as_good_as`); "sampling"
+    says which rows of the logs the fits and the held-out evaluation used (`Resolution.sampling`:
+    decimation, the training cap).
     """
     if not train or not holdout:
         raise RecordingError("the diagnosis needs at least one training and one held-out recording")

@@ -28,8 +28,8 @@ Two checks, each giving a reason when it fails (a fit that passes both has no re
    true lumen compression seed 98 named 0.82. Until 2026-12-07 the rule took c T_max, the arm at the
    base, where the model has no element: at 12.5 mm elements the fits of five true rod lumen
    compressions (seeds 104, 106, 111 twice, 113; extents 6.5-9.3 mm) had c T_max of 1.04-3.1 and were
-   rejected, but at the first element's centre four of them squeeze 0.50-0.92 (seed 106's 1.19); so do
-   two of the three stiffness steps rejected on fresh seeds (101, 102: 0.68, 0.96; 103: 1.35). A
+   rejected, but at the first element's centre four of them squeeze 0.50-0.92 (seed 106's 1.19), as do
+   two of the three stiffness steps it rejected on fresh seeds (101, 102: 0.68, 0.96; 103 stays at 1.35). A
    rate lag must be resolvable at the fits' sampling: its time constant at least
    MIN_LAG_SAMPLES of a (decimated) sample period. A lag shorter than that moves each sample by
    less than it moves between samples; with tau -> 0 the creep s + tau ds/dt = c T is the
@@ -230,13 +230,14 @@ def range_reasons(effect_id: str, values: tuple[float, ...], flexible_length_mm:
     reasons = []
     squeeze = lumen_squeeze(values, max_summed_tension_n, element_length_mm) \
         if effect_id == "lumen_compression" and max_summed_tension_n is not None else 0.0
-    where = "at the base" if element_length_mm is None else \
-        f"at the first element's centre ({element_length_mm / 2:.3g} mm from the base)"
     if squeeze > MAX_LUMEN_SQUEEZE:
-        reasons.append(f"lumen_compression.coef_per_n = {values[0]:.3g} /N over {values[1]:.3g} mm at the largest summed "
-                       f"drive tension of the training logs ({max_summed_tension_n:.3g} N) shrinks the moment arm "
-                       f"{where} to {1.0 / (1.0 + squeeze):.0%} of the lumen offset: a lumen pushed more than half way to the "
-                       "neutral axis is not a wall giving under load but another catheter (softer, or bent elsewhere)")
+        where = "at the base" if element_length_mm is None else \
+            f"at the first element's centre ({element_length_mm / 2:.3g} mm from the base)"
+        reasons.append(f"lumen_compression.coef_per_n = {values[0]:.3g} /N over {values[1]:.3g} mm at the largest "
+                       f"summed drive tension of the training logs ({max_summed_tension_n:.3g} N) shrinks the moment "
+                       f"arm {where} to {1.0 / (1.0 + squeeze):.0%} of the lumen offset: a lumen pushed more than half "
+                       "way to the neutral axis is not a wall giving under load but another catheter (softer, or bent "
+                       "elsewhere)")
     if effect_id == "rate_lag" and sample_period_s is not None and values[1] < MIN_LAG_SAMPLES * sample_period_s:
         reasons.append(f"rate_lag.time_s = {values[1]:.3g} s is shorter than {MIN_LAG_SAMPLES:g} of the fits' sample "
                        f"period ({sample_period_s:g} s): a lag that short is not resolved, it is an elastic drive "

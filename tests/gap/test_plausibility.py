@@ -235,8 +235,9 @@ def test_lumen_compression_along_the_whole_catheter_is_not_near_the_base():
 
 def test_a_lumen_pushed_more_than_half_way_to_the_neutral_axis_is_implausible():
     """Without the element length, the continuous arm at the base, r / (1 + c T_max) at the largest summed
-    drive tension T_max: c T_max = 1 halves it, the bound. The values are rod seed 98's: its true lumen compression (c = 0.044 /N at
-    18.6 N: the arm at 55 %) and the stiffness step named lumen_compression (0.35 /N at 5.4 N: 35 %)."""
+    drive tension T_max: c T_max = 1 halves it, the bound. The values are rod seed 98's: its true lumen
+    compression (c = 0.044 /N at 18.6 N: the arm at 55 %) and the stiffness step named lumen_compression
+    (0.35 /N at 5.4 N: 35 %)."""
     assert range_reasons("lumen_compression", (0.044, 7.3), max_summed_tension_n=18.6) == []
     assert range_reasons("lumen_compression", (0.05, 20.0), max_summed_tension_n=20.0) == []     # exactly half
     reasons = range_reasons("lumen_compression", (0.35, 16.5), max_summed_tension_n=5.4)
