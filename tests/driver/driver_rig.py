@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import multiprocessing
 import struct
-import threading
 from dataclasses import replace
 
 import can
@@ -29,6 +28,7 @@ from drive_process import MARKER_COB_ID, MARKER_ECHO_COB_ID, serve_drives
 from sim_backend.drive.drive_spec import DriveSpec
 from sim_backend.faults import FaultKind
 from sim_backend.time_stamps import TIME_ACK_COB_ID, time_stamp_frame
+from tests.frame_recorder import FrameRecorder
 
 #: Wall time a reply may take: the drives' process answers from its own threads, which a loaded
 #: 2-core machine can hold back for well over 0.1 s.
@@ -77,39 +77,6 @@ def drive_specs(config: TestbedConfig, insertion_start_mm: float = INSERTION_STA
     return specs
 
 
-class FrameRecorder(can.Listener):
-    """Every frame on the bus, in the order they were carried."""
-
-    def __init__(self) -> None:
-        self.frames: list[can.Message] = []
-        self.arrived = threading.Condition()
-
-    def on_message_received(self, msg: can.Message) -> None:
-        with self.arrived:
-            self.frames.append(msg)
-            self.arrived.notify_all()
-
-    def snapshot(self) -> list[can.Message]:
-        with self.arrived:
-            return list(self.frames)
-
-    def wait_for_frame(self, matches, after: int, what: str) -> None:
-        """Wait until a frame that `matches` arrives at an index >= `after`."""
-        searched = [after]
-
-        def arrived(frames) -> bool:
-            found = any(matches(frame) for frame in frames[searched[0]:])
-            searched[0] = len(frames)
-            return found
-
-        with self.arrived:
-            if not self.arrived.wait_for(lambda: arrived(self.frames), timeout=WAIT_S):
-                raise AssertionError(f"timed out waiting for {what}")
-
-    def stop(self) -> None:
-        """Listener interface: nothing to release."""
-
-
 class Rig:
     """The drives of `specs` in their own process, a Testbed on a stepped clock, and a recorder of
     every frame, all on the bus the drives' process serves."""
@@ -127,7 +94,7 @@ class Rig:
             self._process.kill()
             raise AssertionError(f"the drives' process did not start within {START_TIMEOUT_S:g} s")
         self.bus_url = self._requests.recv()
-        self.recorder = FrameRecorder()
+        self.recorder = FrameRecorder(WAIT_S)
         self._recorder_bus = ServedBus(self.bus_url)
         self._recorder_notifier = can.Notifier(self._recorder_bus, [self.recorder], timeout=0.05)
         self.bus = ServedBus(self.bus_url)

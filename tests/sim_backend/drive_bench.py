@@ -10,7 +10,6 @@ drives and every frame they sent in reply has reached the client's callbacks.
 
 from __future__ import annotations
 
-import threading
 import uuid
 from dataclasses import replace
 from pathlib import Path
@@ -21,6 +20,7 @@ from canopen.profiles.p402 import BaseNode402
 
 from sim_backend.drive.drive_spec import DriveSpec
 from sim_backend.drives import SimDriveSet
+from tests.frame_recorder import FrameRecorder
 
 EDS_PATH = Path(__file__).resolve().parents[2] / "configs" / "crest_drive.eds"
 MASTER_NODE_ID = 127
@@ -46,45 +46,12 @@ def insertion_spec(name: str = "insertion", node_id: int = 5, **overrides) -> Dr
     return replace(spec, **overrides)
 
 
-class FrameRecorder(can.Listener):
-    """Every frame the client sees, with a condition to wait on."""
-
-    def __init__(self) -> None:
-        self.frames: list[can.Message] = []
-        self.arrived = threading.Condition()
-
-    def on_message_received(self, msg: can.Message) -> None:
-        with self.arrived:
-            self.frames.append(msg)
-            self.arrived.notify_all()
-
-    def with_id(self, cob_id: int) -> list[can.Message]:
-        with self.arrived:
-            return [frame for frame in self.frames if not frame.is_error_frame and frame.arbitration_id == cob_id]
-
-    def error_frames(self) -> list[can.Message]:
-        with self.arrived:
-            return [frame for frame in self.frames if frame.is_error_frame]
-
-    def wait_for(self, predicate, what: str) -> None:
-        with self.arrived:
-            if not self.arrived.wait_for(lambda: predicate(self.frames), timeout=WAIT_S):
-                raise AssertionError(f"timed out waiting for {what}")
-
-    def clear(self) -> None:
-        with self.arrived:
-            self.frames.clear()
-
-    def stop(self) -> None:
-        """Listener interface: nothing to release."""
-
-
 class DriveBench:
     """Drives for ``specs`` plus a client network with a BaseNode402 per drive."""
 
     def __init__(self, specs: list[DriveSpec], faults=()) -> None:
         self.channel = f"crest-test-{uuid.uuid4().hex}"
-        self.recorder = FrameRecorder()
+        self.recorder = FrameRecorder(WAIT_S)
         self.client = canopen.Network()
         self.client.listeners.append(self.recorder)
         self.client.NOTIFIER_CYCLE = 0.05  # short shutdown
