@@ -195,9 +195,5 @@ class TipEstimator:
         return jacobian @ self.filter.P @ jacobian.T
 
     @property
-    def tip_bias_mm(self) -> np.ndarray:
-        return self.filter.x[:3, 0].copy()
-
-    @property
     def friction_scale(self) -> float:
         return float(self.filter.x[3, 0])

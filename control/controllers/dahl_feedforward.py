@@ -19,7 +19,7 @@ from model import DahlCatheter
 
 from control.command_limiter import CommandLimiter
 from control.controllers.controller import Controller, checked_setpoint
-from control.dahl_inverse import DahlInverse, InverseSolution
+from control.dahl_inverse import DahlInverse
 from control.inverse_kinematics import tendons_from_pulls
 from control.model_reset import reset_straight
 from control.motion_limits import MotionLimits
@@ -30,8 +30,7 @@ from control.workspace import Workspace
 
 
 class DahlFeedforward(Controller):
-    """model: the controller's DahlCatheter (workspace.params, n_elements), state = what was sent.
-    last_solution: the InverseSolution of the last cycle (residual, evaluations) for logging."""
+    """model: the controller's DahlCatheter (workspace.params, n_elements), state = what was sent."""
 
     name = "dahl"
 
@@ -53,7 +52,6 @@ class DahlFeedforward(Controller):
         reset_straight(self.model, insertion_mm)
         self.inverse.reset()
         self.limiter.reset(insertion_mm=insertion_mm)
-        self.last_solution: InverseSolution | None = None
         self._x: np.ndarray | None = None       # last command sent, (p_x, p_y, L)
         self._x_cc: np.ndarray | None = None    # the constant-curvature command of the last set-point
 
@@ -70,7 +68,7 @@ class DahlFeedforward(Controller):
         x, _ = self.limiter.limit(solution.x)
         tendons = tendons_from_pulls(x[:2], self.workspace.pretension_mm)
         predicted = self.model.move_to(tendons, x[2])
-        self._x, self._x_cc, self.last_solution = x, x_cc, solution
+        self._x, self._x_cc = x, x_cc
         return TendonCommand(tendons, float(x[2]), predicted, solution.limited)
 
     def _bounds(self, insertion_mm: float) -> tuple[np.ndarray, np.ndarray]:

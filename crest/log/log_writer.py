@@ -120,11 +120,6 @@ class LogWriter:
         self._size_bytes = 0
         self._size_bytes = self._write_and_sync(",".join(self.columns) + "\n")
 
-    @property
-    def rows_written(self) -> int:
-        """Rows accepted so far (written or waiting for the next flush)."""
-        return self._rows_written
-
     def write(self, t_s: float, tendon_cmd_mm: Sequence[float], insertion_cmd_mm: float,
               tendon_pos_mm: Sequence[float | None], insertion_pos_mm: float | None,
               tip_mm: Sequence[float] | None = None, *, tendon_force_n: Sequence[float | None] | None = None,
