@@ -96,11 +96,6 @@ class CatheterParams:
         """The dynamic mode is on exactly when the bends have damping or inertia."""
         return self.damping_time_s > 0 or self.inertia_scale > 0
 
-    @property
-    def friction_enabled(self) -> bool:
-        """Friction is off exactly when mu = 0 and Fsc = 0."""
-        return self.mu > 0 or self.fsc_n_per_mm > 0
-
     def replace(self, **changes) -> "CatheterParams":
         """A new, validated parameter set with `changes` applied; self is unchanged."""
         return dataclasses.replace(self, **changes)

@@ -195,14 +195,6 @@ class SimDrive:
             else:
                 raise ValueError(f"drive {self.name!r}: {kind.value!r} is a tracker fault, not a drive fault")
 
-    def clear_injected_faults(self) -> None:
-        """Undo injected conditions (the drive stays in FAULT until the master resets it)."""
-        with self._lock:
-            self.silent = False
-            self.sdo_silent = False
-            self._servo.stalled = False
-            self.error_frames_active = False
-
     # --- bus entry points --------------------------------------------------------------
     def _listening(self) -> bool:
         return self._powered and not self.silent
